@@ -1,0 +1,55 @@
+// semsegmap: the command line. Each subcommand lives in its own cmd_*.cpp; errors become one
+// line on stderr and a non-zero exit.
+#include <cstring>
+#include <exception>
+#include <functional>
+#include <iostream>
+#include <map>
+
+#include "cli_args.h"
+
+namespace {
+
+const char* kUsage = R"(usage: semsegmap <command> [options]
+
+commands:
+  simulate           --world-seed N --run S0|S1|S2|S3 [--condition sunny|sunrise]
+                     [--traffic-seed M] [--max-frames K] [--world full|small|tiny] --out DIR
+  simulate-overview  --world-seed N [--world full|small|tiny] --out FILE.png
+                     [--cameras FILE.png] [--run S2] [--frame I]
+  demo               [--out DIR]   the main job on simulated data
+
+run 'semsegmap <command> --help' for a command's options.
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using Command = std::function<int(const std::vector<std::string>&)>;
+  const std::map<std::string, Command> commands = {
+      {"simulate", semsegmap::app::runSimulate},
+      {"simulate-overview", semsegmap::app::runSimulateOverview},
+      {"demo", semsegmap::app::runDemo},
+  };
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    std::cout << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  auto it = commands.find(argv[1]);
+  if (it == commands.end()) {
+    std::cerr << "semsegmap: unknown command '" << argv[1] << "'\n" << kUsage;
+    return 2;
+  }
+  std::vector<std::string> args(argv + 2, argv + argc);
+  for (const auto& a : args)
+    if (a == "--help" || a == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+  try {
+    return it->second(args);
+  } catch (const std::exception& e) {
+    std::cerr << "semsegmap " << argv[1] << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,44 @@
+// One synchronised capture of the rig: the value type that flows from datasets and the
+// simulator into the pipeline.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "semsegmap/core/class_table.h"
+#include "semsegmap/core/image.h"
+#include "semsegmap/core/pose.h"
+
+namespace semsegmap {
+
+// A LiDAR return in the LiDAR frame (KITTI's float32 layout).
+struct LidarPoint {
+  float x = 0, y = 0, z = 0, intensity = 0;
+};
+
+// Ground truth for one LiDAR point (simulation, or SemanticKITTI labels).
+struct PointLabel {
+  ClassId class_id = cls::kUnknown;
+  uint16_t instance_id = 0;  // 0: no instance
+  bool operator==(const PointLabel& o) const {
+    return class_id == o.class_id && instance_id == o.instance_id;
+  }
+};
+
+struct CameraFrame {
+  Image rgb;    // 3 channels; empty when the dataset has no color
+  Image label;  // 1 channel of class ids; empty when no semantics
+};
+
+struct Frame {
+  size_t index = 0;
+  double timestamp_s = 0.0;
+  std::vector<LidarPoint> points;
+  std::vector<PointLabel> point_labels;  // empty, or one per point
+  std::vector<CameraFrame> cameras;      // in the order of SensorRig::cameras
+  Pose T_world_base_odom = Pose::Identity();
+  std::optional<Pose> T_world_base_gt;
+};
+
+}  // namespace semsegmap

@@ -1,0 +1,30 @@
+// Where frames come from: the simulator streams them, io/ reads them from disk. The pipeline
+// only sees this interface.
+#pragma once
+
+#include <string>
+
+#include "semsegmap/core/class_table.h"
+#include "semsegmap/core/frame.h"
+#include "semsegmap/core/sensor_rig.h"
+
+namespace semsegmap {
+
+struct DatasetInfo {
+  std::string name;
+  SensorRig rig;
+  ClassTable classes = ClassTable::Default();
+  bool has_ground_truth_poses = false;
+  bool has_point_labels = false;
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual const DatasetInfo& info() const = 0;
+  virtual size_t size() const = 0;
+  // Random access; throws with a message naming the file when a frame cannot be produced.
+  virtual Frame frame(size_t index) = 0;
+};
+
+}  // namespace semsegmap

@@ -1,0 +1,63 @@
+// The sensor rig: a spinning LiDAR and pinhole cameras, with the calibrations that the
+// enrichment needs (intrinsics, LiDAR-to-camera extrinsics) and the LiDAR mounting on the base.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "semsegmap/core/pose.h"
+
+namespace semsegmap {
+
+struct LidarModel {
+  int columns = 1920;        // horizontal beams per revolution of the field of view
+  int rows = 64;             // vertical beams
+  double hfov_deg = 270.0;   // centred on the LiDAR's +x (forward)
+  double vfov_up_deg = 2.0;  // HDL-64-like vertical field of view
+  double vfov_down_deg = -24.8;
+  double min_range_m = 0.9;
+  double max_range_m = 100.0;
+  double range_noise_m = 0.02;  // Gaussian sigma
+  double dropout = 0.01;        // probability that a return is lost
+
+  // Unit direction of beam (row, col) in the LiDAR frame; row 0 is the top beam.
+  Eigen::Vector3d beamDirection(int row, int col) const;
+};
+
+// Pinhole camera in the OpenCV convention (x right, y down, z forward), no distortion
+// (rectified images). T_camera_lidar maps LiDAR points into the camera frame.
+struct PinholeCamera {
+  std::string name;
+  int width = 640;
+  int height = 480;
+  double fx = 320.0, fy = 320.0, cx = 320.0, cy = 240.0;
+  Pose T_camera_lidar = Pose::Identity();
+
+  // Pixel of a point given in the camera frame, or nothing when it is behind the camera.
+  std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& p_camera) const;
+  // Unit ray through pixel (u, v) in the camera frame.
+  Eigen::Vector3d pixelRay(double u, double v) const;
+  bool inImage(const Eigen::Vector2d& uv) const {
+    return uv.x() >= 0 && uv.y() >= 0 && uv.x() < width && uv.y() < height;
+  }
+};
+
+struct SensorRig {
+  LidarModel lidar;
+  Pose T_base_lidar = Pose::Identity();
+  std::vector<PinholeCamera> cameras;
+  double rate_hz = 5.0;
+
+  // Throws std::invalid_argument naming the field when the rig cannot be right
+  // (non-positive sizes or focal lengths, a principal point far outside the image, ...).
+  void validate() const;
+};
+
+// The paper's simulated rig: LiDAR 1920 x 64 over 270 degrees, three 90-degree cameras
+// (left, front, right) at 640 x 480, mounted with a few decimetres of parallax.
+SensorRig defaultSimRig();
+
+}  // namespace semsegmap

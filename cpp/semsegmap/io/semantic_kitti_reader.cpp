@@ -1,0 +1,195 @@
+#include "semsegmap/io/semantic_kitti_reader.h"
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include "semsegmap/io/dataset_format.h"
+#include "semsegmap/io/kitti_calib.h"
+
+namespace semsegmap {
+namespace fs = std::filesystem;
+namespace {
+
+// One line of numbers per entry; blank lines are skipped, but every other line counts so that
+// line n stays frame n.
+std::vector<std::vector<double>> readNumberLines(const fs::path& path, size_t per_line) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open");
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  for (int line_no = 1; std::getline(in, line); ++line_no) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::string where = path.string() + ": line " + std::to_string(line_no);
+    std::vector<double> v;
+    try {
+      v = parseNumbers(line);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(where + ": " + e.what());
+    }
+    if (v.size() != per_line)
+      throw std::runtime_error(where + ": expected " + std::to_string(per_line) +
+                               " values, found " + std::to_string(v.size()));
+    rows.push_back(std::move(v));
+  }
+  return rows;
+}
+
+}  // namespace
+
+const std::vector<SemanticKittiClass>& semanticKittiClasses() {
+  static const std::vector<SemanticKittiClass> table = {
+      {0, "unlabeled", cls::kUnknown},
+      {1, "outlier", cls::kUnknown},
+      {10, "car", cls::kCar},
+      {11, "bicycle", cls::kCar},  // our table has one dynamic vehicle class
+      {13, "bus", cls::kCar},
+      {15, "motorcycle", cls::kCar},
+      {16, "on-rails", cls::kCar},
+      {18, "truck", cls::kCar},
+      {20, "other-vehicle", cls::kCar},
+      {30, "person", cls::kPerson},
+      {31, "bicyclist", cls::kPerson},  // the rider; dynamic like a pedestrian
+      {32, "motorcyclist", cls::kPerson},
+      {40, "road", cls::kRoad},
+      {44, "parking", cls::kRoad},
+      {48, "sidewalk", cls::kSidewalk},
+      {49, "other-ground", cls::kTerrain},  // ground that is neither road nor sidewalk
+      {50, "building", cls::kBuilding},
+      {51, "fence", cls::kFence},
+      {52, "other-structure", cls::kOther},
+      {60, "lane-marking", cls::kRoad},  // paint on the road surface
+      {70, "vegetation", cls::kVegetation},
+      {71, "trunk", cls::kTrunk},
+      {72, "terrain", cls::kTerrain},
+      {80, "pole", cls::kPole},
+      {81, "traffic-sign", cls::kTrafficSign},
+      {99, "other-object", cls::kOther},
+      {252, "moving-car", cls::kCar},
+      {253, "moving-bicyclist", cls::kPerson},
+      {254, "moving-person", cls::kPerson},
+      {255, "moving-motorcyclist", cls::kPerson},
+      {256, "moving-on-rails", cls::kCar},
+      {257, "moving-bus", cls::kCar},
+      {258, "moving-truck", cls::kCar},
+      {259, "moving-other-vehicle", cls::kCar},
+  };
+  return table;
+}
+
+ClassId semanticKittiToClass(uint16_t label) {
+  // A dense lookup over the id range SemanticKITTI uses; this runs for every point.
+  static const std::array<ClassId, 260> lookup = [] {
+    std::array<ClassId, 260> a;
+    a.fill(cls::kOther);
+    for (const auto& c : semanticKittiClasses()) a[c.label] = c.class_id;
+    return a;
+  }();
+  return label < lookup.size() ? lookup[label] : cls::kOther;
+}
+
+SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
+    : dir_(fs::absolute(sequence_dir).lexically_normal()) {
+  if (dir_.filename().empty()) dir_ = dir_.parent_path();
+  const fs::path scan_dir = dir_ / "velodyne";
+  if (!fs::is_directory(scan_dir))
+    throw std::runtime_error(scan_dir.string() + ": missing (not a SemanticKITTI sequence)");
+  const auto scans = listKittiFrames(scan_dir, ".bin");
+  if (scans.empty()) throw std::runtime_error(scan_dir.string() + ": no .bin scans");
+
+  const fs::path label_dir = dir_ / "labels";
+  const bool has_labels = fs::is_directory(label_dir);
+  const fs::path times_path = dir_ / "times.txt";
+  const bool has_times = fs::exists(times_path);
+  std::vector<double> times;
+  if (has_times)
+    for (const auto& row : readNumberLines(times_path, 1)) times.push_back(row[0]);
+
+  const fs::path poses_path = dir_ / "poses.txt";
+  const bool has_poses = fs::exists(poses_path);
+  std::vector<Pose> poses;
+  if (has_poses) {
+    // SemanticKITTI's poses are of camera 0; Tr moves them onto the Velodyne.
+    const KittiCalibFile calib(dir_ / "calib.txt");
+    const Pose Tr = calib.transform3x4("Tr");
+    const Pose Tr_inv = Tr.inverse(Eigen::Affine);
+    int line_no = 0;
+    for (const auto& row : readNumberLines(poses_path, 12)) {
+      ++line_no;
+      Eigen::Matrix3d R;
+      R << row[0], row[1], row[2], row[4], row[5], row[6], row[8], row[9], row[10];
+      checkRotation(R, poses_path.string() + ": pose " + std::to_string(line_no));
+      Pose T_world_cam = Pose::Identity();
+      T_world_cam.linear() = R;
+      T_world_cam.translation() = Eigen::Vector3d(row[3], row[7], row[11]);
+      Pose T_world_lidar = Tr_inv * T_world_cam * Tr;
+      // The files print 7 digits; a clean rotation keeps Pose::inverse() exact downstream.
+      T_world_lidar.linear() = nearestRotation(T_world_lidar.linear());
+      poses.push_back(T_world_lidar);
+    }
+  }
+
+  for (const auto& [number, scan] : scans) {
+    FrameFiles f;
+    f.scan = scan;
+    if (has_labels) {
+      f.labels = label_dir / (scan.stem().string() + ".label");
+      if (!fs::is_regular_file(f.labels))
+        throw std::runtime_error(f.labels.string() + ": missing (the labels of scan " +
+                                 scan.string() + ")");
+    }
+    if (has_times) {
+      if (number >= times.size())
+        throw std::runtime_error(times_path.string() + ": no time for frame " +
+                                 std::to_string(number) + " (" + std::to_string(times.size()) +
+                                 " lines)");
+      f.timestamp_s = times[number];
+    } else {
+      f.timestamp_s = static_cast<double>(number) * 0.1;  // the Velodyne's 10 Hz
+    }
+    if (has_poses) {
+      if (number >= poses.size())
+        throw std::runtime_error(poses_path.string() + ": no pose for frame " +
+                                 std::to_string(number) + " (" + std::to_string(poses.size()) +
+                                 " poses)");
+      f.T_world_lidar = poses[number];
+    }
+    frames_.push_back(std::move(f));
+  }
+
+  info_.name = "semantickitti:" + dir_.filename().string();
+  info_.rig.lidar = velodyneHdl64e();
+  info_.rig.T_base_lidar = Pose::Identity();  // as in KITTI raw, the base is the Velodyne
+  info_.rig.rate_hz = 10.0;
+  info_.classes = ClassTable::Default();
+  info_.has_ground_truth_poses = has_poses;
+  info_.has_point_labels = has_labels;
+}
+
+Frame SemanticKittiReader::frame(size_t index) {
+  if (index >= frames_.size())
+    throw std::out_of_range(info_.name + ": frame " + std::to_string(index) + " out of range (" +
+                            std::to_string(frames_.size()) + " frames)");
+  const FrameFiles& files = frames_[index];
+  Frame f;
+  f.index = index;
+  f.timestamp_s = files.timestamp_s;
+  f.points = readLidarBin(files.scan);  // rejects truncation and NaN/inf, naming the point
+  if (!files.labels.empty()) {
+    f.point_labels = readLabelBin(files.labels);
+    if (f.point_labels.size() != f.points.size())
+      throw std::runtime_error(
+          files.labels.string() + ": " + std::to_string(f.point_labels.size()) + " labels but " +
+          files.scan.string() + " has " + std::to_string(f.points.size()) + " points");
+    for (PointLabel& l : f.point_labels) l.class_id = semanticKittiToClass(l.class_id);
+  }
+  if (files.T_world_lidar) {
+    f.T_world_base_gt = *files.T_world_lidar;
+    f.T_world_base_odom = *files.T_world_lidar;
+  }
+  return f;
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,64 @@
+#include "semsegmap/sim/simulator.h"
+
+#include "semsegmap/core/random.h"
+#include "semsegmap/sim/camera_sim.h"
+#include "semsegmap/sim/lidar_sim.h"
+
+namespace semsegmap::sim {
+
+Simulator::Simulator(const SimConfig& config)
+    : config_(config),
+      traffic_seed_(config.traffic_seed ? *config.traffic_seed
+                                        : static_cast<uint64_t>(config.run) + 1),
+      world_(std::make_unique<World>(generateWorld(config.world, traffic_seed_))),
+      scene_(std::make_unique<RayScene>(*world_)),
+      lighting_(
+          lightingFor(config.condition.empty() ? defaultCondition(config.run) : config.condition)) {
+  config_.rig.validate();
+  config_.trajectory.rate_hz = config_.rig.rate_hz;
+  trajectory_ = makeTrajectory(world_->roads, config.run, config_.trajectory, config_.odometry,
+                               hashKeys(config.world.seed, static_cast<uint64_t>(config.run)));
+  info_.name = "sim world " + std::to_string(config.world.seed) + " run " + runName(config.run) +
+               " " + lighting_.name + " traffic " + std::to_string(traffic_seed_);
+  info_.rig = config_.rig;
+  if (!config_.render_cameras) info_.rig.cameras.clear();
+  info_.classes = ClassTable::Default();
+  info_.has_ground_truth_poses = true;
+  info_.has_point_labels = true;
+}
+
+Simulator::~Simulator() = default;
+
+size_t Simulator::size() const {
+  const size_t n = trajectory_.T_world_base_gt.size();
+  return config_.max_frames > 0 ? std::min(n, config_.max_frames) : n;
+}
+
+Frame Simulator::frame(size_t index) {
+  if (index >= size())
+    throw std::out_of_range("simulator: frame " + std::to_string(index) + " of " +
+                            std::to_string(size()));
+  Frame f;
+  f.index = index;
+  f.timestamp_s = trajectory_.timestamps_s[index];
+  f.T_world_base_gt = trajectory_.T_world_base_gt[index];
+  f.T_world_base_odom = trajectory_.T_world_base_odom[index];
+  const Pose& T_world_base = *f.T_world_base_gt;
+  scene_->setTime(f.timestamp_s, T_world_base.translation().head<2>(), config_.agent_clearance_m);
+
+  const uint64_t seed =
+      hashKeys(config_.world.seed, traffic_seed_, static_cast<uint64_t>(config_.run), index);
+  const Pose T_world_lidar = T_world_base * config_.rig.T_base_lidar;
+  LidarScan scan = simulateLidar(*scene_, config_.rig.lidar, T_world_lidar, seed);
+  f.points = std::move(scan.points);
+  f.point_labels = std::move(scan.labels);
+  for (size_t c = 0; c < info_.rig.cameras.size(); ++c) {
+    const PinholeCamera& cam = info_.rig.cameras[c];
+    CameraRender r = renderCamera(*scene_, cam, T_world_lidar * cam.T_camera_lidar.inverse(),
+                                  lighting_, hashKeys(seed, c + 1));
+    f.cameras.push_back({std::move(r.rgb), std::move(r.label)});
+  }
+  return f;
+}
+
+}  // namespace semsegmap::sim

@@ -1,0 +1,121 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "semsegmap/core/class_table.h"
+#include "semsegmap/core/pose.h"
+#include "semsegmap/core/random.h"
+#include "semsegmap/core/sensor_rig.h"
+
+using namespace semsegmap;
+
+TEST(ClassTable, DefaultHasThePaperClassesWithTheirFlags) {
+  const ClassTable t = ClassTable::Default();
+  for (const char* name : {"road", "sidewalk", "terrain", "building", "roof", "fence", "vegetation",
+                           "trunk", "pole", "traffic-sign", "car", "person", "other", "unknown"})
+    EXPECT_TRUE(t.find(name).has_value()) << name;
+  EXPECT_TRUE(t.at(*t.find("car")).dynamic);
+  EXPECT_TRUE(t.at(*t.find("person")).dynamic);
+  EXPECT_FALSE(t.at(*t.find("building")).dynamic);
+  for (const char* g : {"road", "sidewalk", "terrain"}) EXPECT_TRUE(t.at(*t.find(g)).ground) << g;
+  EXPECT_FALSE(t.at(*t.find("vegetation")).ground);
+  EXPECT_THROW(t.at(999), std::out_of_range);
+}
+
+TEST(ClassTable, RejectsDuplicateIds) {
+  EXPECT_THROW(ClassTable({{1, "a", {0, 0, 0}, false, false}, {1, "b", {0, 0, 0}, false, false}}),
+               std::invalid_argument);
+}
+
+TEST(Pose, XyzQuatRoundTrip) {
+  Pose T = planarPose(1.0, -2.0, 0.5, 0.7);
+  T.linear() = T.linear() * Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Pose back = fromXyzQuat(toXyzQuat(T));
+  EXPECT_LT(translationError(T, back), 1e-12);
+  EXPECT_LT(rotationErrorDeg(T, back), 1e-6);
+}
+
+TEST(Pose, YawAndErrors) {
+  EXPECT_NEAR(yawOf(planarPose(0, 0, 0, 1.25)), 1.25, 1e-12);
+  EXPECT_NEAR(rotationErrorDeg(planarPose(0, 0, 0, 0), planarPose(0, 0, 0, M_PI / 2)), 90.0, 1e-9);
+  EXPECT_NEAR(translationError(planarPose(0, 0, 0, 0), planarPose(3, 4, 0, 1)), 5.0, 1e-12);
+}
+
+TEST(Random, CounterBasedIsAPureFunction) {
+  EXPECT_EQ(hashKeys(1, 2, 3), hashKeys(1, 2, 3));
+  EXPECT_NE(hashKeys(1, 2, 3), hashKeys(1, 3, 2));
+  double sum = 0, sum2 = 0;
+  const int n = 20000;
+  for (int k = 0; k < n; ++k) {
+    const double g = gaussianFromHash(hashKeys(7, k));
+    sum += g;
+    sum2 += g * g;
+  }
+  EXPECT_NEAR(sum / n, 0.0, 0.03);
+  EXPECT_NEAR(sum2 / n, 1.0, 0.05);
+  SeededRng a(5), b(5);
+  for (int k = 0; k < 10; ++k) EXPECT_EQ(a.next(), b.next());
+  std::set<int> seen;
+  SeededRng c(9);
+  for (int k = 0; k < 1000; ++k) {
+    const int v = c.integer(2, 4);
+    ASSERT_GE(v, 2);
+    ASSERT_LE(v, 4);
+    seen.insert(v);
+  }
+  EXPECT_EQ(seen.size(), 3u);
+}
+
+TEST(SensorRig, DefaultRigLooksLeftFrontRight) {
+  const SensorRig rig = defaultSimRig();
+  ASSERT_EQ(rig.cameras.size(), 3u);
+  EXPECT_NO_THROW(rig.validate());
+  // A point straight ahead of the LiDAR lands near the centre of the front camera...
+  const auto& front = rig.cameras[1];
+  const auto uv = front.project(front.T_camera_lidar * Eigen::Vector3d(20.0, 0.0, -0.25));
+  ASSERT_TRUE(uv.has_value());
+  EXPECT_NEAR(uv->x(), 320.0, 1.0);
+  EXPECT_NEAR(uv->y(), 240.0, 1.0);
+  // ...and behind the left camera's image plane for a point on the right.
+  const auto& left = rig.cameras[0];
+  EXPECT_FALSE(left.project(left.T_camera_lidar * Eigen::Vector3d(0.0, -10.0, 0.0)).has_value());
+  // Each camera sees 90 degrees: the image edge of the front camera is at 45 degrees.
+  const auto edge = front.project(front.T_camera_lidar * Eigen::Vector3d(20.0, 20.0 - 0.0, -0.25));
+  ASSERT_TRUE(edge.has_value());
+  EXPECT_NEAR(edge->x(), 0.0, 8.0);
+}
+
+TEST(SensorRig, PixelRayInvertsProjection) {
+  const PinholeCamera cam = defaultSimRig().cameras[1];
+  const Eigen::Vector3d ray = cam.pixelRay(100.5, 400.25);
+  const auto uv = cam.project(ray * 7.0);
+  ASSERT_TRUE(uv.has_value());
+  EXPECT_NEAR(uv->x(), 100.5, 1e-9);
+  EXPECT_NEAR(uv->y(), 400.25, 1e-9);
+}
+
+TEST(SensorRig, LidarBeamsSpanTheFieldOfView) {
+  const LidarModel l;
+  const Eigen::Vector3d first = l.beamDirection(0, 0),
+                        last = l.beamDirection(l.rows - 1, l.columns - 1);
+  EXPECT_NEAR(std::atan2(first.y(), first.x()) * 180 / M_PI, 135.0, 0.1);
+  EXPECT_NEAR(std::atan2(last.y(), last.x()) * 180 / M_PI, -135.0, 0.1);
+  EXPECT_NEAR(std::asin(first.z()) * 180 / M_PI, l.vfov_up_deg, 1e-9);
+  EXPECT_NEAR(std::asin(last.z()) * 180 / M_PI, l.vfov_down_deg, 1e-9);
+}
+
+TEST(SensorRig, ValidateNamesTheBadField) {
+  SensorRig rig = defaultSimRig();
+  rig.cameras[2].fx = -1.0;
+  try {
+    rig.validate();
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("right"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fx"), std::string::npos) << e.what();
+  }
+  rig = defaultSimRig();
+  rig.cameras[0].T_camera_lidar.linear() *= 2.0;
+  EXPECT_THROW(rig.validate(), std::invalid_argument);
+}
