@@ -28,5 +28,8 @@ class CliArgs {
 int runSimulate(const std::vector<std::string>& args);
 int runSimulateOverview(const std::vector<std::string>& args);
 int runDemo(const std::vector<std::string>& args);
+int runEnrich(const std::vector<std::string>& args);
+int runConvert(const std::vector<std::string>& args);
+int runSegment(const std::vector<std::string>& args);
 
 }  // namespace semsegmap::app

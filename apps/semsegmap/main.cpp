@@ -17,7 +17,16 @@ commands:
                      [--traffic-seed M] [--max-frames K] [--world full|small|tiny] --out DIR
   simulate-overview  --world-seed N [--world full|small|tiny] --out FILE.png
                      [--cameras FILE.png] [--run S2] [--frame I]
+  enrich             --dataset SPEC [--frame I] --out FILE.png [--ply FILE.ply] [--camera K]
+                     LiDAR points coloured from the cameras, drawn over camera K
+  convert            --dataset SPEC --out DIR [--max-frames K]
+                     any dataset written in the project's format
+  segment            --dataset SPEC --config FILE --out DIR [--poses gt|odom] [--max-frames K]
+                     enrichment + local map + incremental segmentation -> segments.csv/.ply/.png
   demo               [--out DIR]   the main job on simulated data
+
+datasets (SPEC): DIR (project format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,
+                 sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small]
 
 run 'semsegmap <command> --help' for a command's options.
 )";
@@ -29,6 +38,9 @@ int main(int argc, char** argv) {
   const std::map<std::string, Command> commands = {
       {"simulate", semsegmap::app::runSimulate},
       {"simulate-overview", semsegmap::app::runSimulateOverview},
+      {"enrich", semsegmap::app::runEnrich},
+      {"convert", semsegmap::app::runConvert},
+      {"segment", semsegmap::app::runSegment},
       {"demo", semsegmap::app::runDemo},
   };
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {

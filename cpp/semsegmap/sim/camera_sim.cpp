@@ -40,40 +40,60 @@ CameraRender renderCamera(const RayScene& scene, const PinholeCamera& camera,
   const Eigen::Matrix3f R = T_world_camera.linear().cast<float>();
   const Eigen::Vector3f origin = T_world_camera.translation().cast<float>();
 
+  constexpr int P = RayScene::kPacket;
 #pragma omp parallel for schedule(dynamic, 4)
   for (int v = 0; v < camera.height; ++v) {
-    for (int u = 0; u < camera.width; ++u) {
-      const Eigen::Vector3f ray_cam = camera.pixelRay(u + 0.5, v + 0.5).cast<float>();
-      const Eigen::Vector3f dir = R * ray_cam;
-      const RayHit hit = scene.intersect(origin, dir, 0.05f, 1e4f);
-      Eigen::Vector3f color;
-      ClassId label = cls::kSky;
-      if (!hit.hit) {
-        const float up = std::clamp(dir.z(), 0.0f, 1.0f);
-        color = (1 - up) * lighting.sky_horizon + up * lighting.sky_zenith;
-      } else {
-        const Surface& s = *hit.surface;
-        label = s.class_id;
-        const Eigen::Vector3f p = origin + dir * hit.t;
-        float tex = 1.0f;
-        if (s.texture > 0) tex = 1.0f + s.texture * (2.0f * valueNoise(p, 1.7f) - 1.0f);
-        const float cos_sun = hit.normal.dot(lighting.to_sun);
-        float direct = 0.0f;
-        if (cos_sun > 0 && !scene.occluded(p + hit.normal * 0.01f, lighting.to_sun, 0.0f, 1e4f))
-          direct = cos_sun;
-        const Eigen::Vector3f light = lighting.ambient + lighting.sun_color * direct;
-        color = (s.albedo * tex).cwiseProduct(light) * lighting.exposure;
-        if (with_depth) out.depth[static_cast<size_t>(v) * camera.width + u] = hit.t * ray_cam.z();
+    for (int u0 = 0; u0 < camera.width; u0 += P) {
+      // Eight neighbouring pixels of a row share one packet for the view rays and one for the
+      // shadow rays.
+      bool active[P], lit_candidate[P], shadowed[P];
+      Eigen::Vector3f origins[P], dirs[P], rays_cam[P], points[P];
+      RayHit hits[P];
+      for (int k = 0; k < P; ++k) {
+        active[k] = u0 + k < camera.width;
+        rays_cam[k] = camera.pixelRay(u0 + k + 0.5, v + 0.5).cast<float>();
+        dirs[k] = R * rays_cam[k];
+        origins[k] = origin;
       }
-      // A little sensor noise, a pure function of the seed and the pixel.
-      const uint64_t h =
-          hashMix(noise_seed ^ (static_cast<uint64_t>(v) << 32 | static_cast<uint64_t>(u)));
-      // Triangular noise (sum of two uniforms): close enough to Gaussian, far cheaper.
-      const float n =
-          0.006f * static_cast<float>(uniformFromHash(h) + uniformFromHash(hashMix(h)) - 1.0);
-      uint8_t* px = out.rgb.at(u, v);
-      for (int c = 0; c < 3; ++c) px[c] = toByte(color[c] + n);
-      *out.label.at(u, v) = static_cast<uint8_t>(label);
+      scene.intersect8(active, origins, dirs, 0.05f, 1e4f, hits);
+      for (int k = 0; k < P; ++k) {
+        lit_candidate[k] = hits[k].hit && hits[k].normal.dot(lighting.to_sun) > 0;
+        if (hits[k].hit) {
+          points[k] = origin + dirs[k] * hits[k].t;
+          origins[k] = points[k] + hits[k].normal * 0.01f;
+        }
+      }
+      scene.occluded8(lit_candidate, origins, lighting.to_sun, 0.0f, 1e4f, shadowed);
+
+      for (int k = 0; k < P && u0 + k < camera.width; ++k) {
+        const int u = u0 + k;
+        const RayHit& hit = hits[k];
+        Eigen::Vector3f color;
+        ClassId label = cls::kSky;
+        if (!hit.hit) {
+          const float up = std::clamp(dirs[k].z(), 0.0f, 1.0f);
+          color = (1 - up) * lighting.sky_horizon + up * lighting.sky_zenith;
+        } else {
+          const Surface& s = *hit.surface;
+          label = s.class_id;
+          float tex = 1.0f;
+          if (s.texture > 0) tex = 1.0f + s.texture * (2.0f * valueNoise(points[k], 1.7f) - 1.0f);
+          const float direct =
+              lit_candidate[k] && !shadowed[k] ? hit.normal.dot(lighting.to_sun) : 0.0f;
+          const Eigen::Vector3f light = lighting.ambient + lighting.sun_color * direct;
+          color = (s.albedo * tex).cwiseProduct(light) * lighting.exposure;
+          if (with_depth)
+            out.depth[static_cast<size_t>(v) * camera.width + u] = hit.t * rays_cam[k].z();
+        }
+        const uint64_t h =
+            hashMix(noise_seed ^ (static_cast<uint64_t>(v) << 32 | static_cast<uint64_t>(u)));
+        // Triangular noise (sum of two uniforms): close enough to Gaussian, far cheaper.
+        const float n =
+            0.006f * static_cast<float>(uniformFromHash(h) + uniformFromHash(hashMix(h)) - 1.0);
+        uint8_t* px = out.rgb.at(u, v);
+        for (int c = 0; c < 3; ++c) px[c] = toByte(color[c] + n);
+        *out.label.at(u, v) = static_cast<uint8_t>(label);
+      }
     }
   }
   return out;

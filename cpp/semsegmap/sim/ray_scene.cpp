@@ -144,23 +144,92 @@ RayHit RayScene::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f&
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(impl_->top, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
+  return hitFrom(rh.hit.instID[0], rh.hit.primID, {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, dir,
+                 rh.ray.tfar);
+}
+
+RayHit RayScene::hitFrom(unsigned inst_id, unsigned prim_id, const Eigen::Vector3f& ng,
+                         const Eigen::Vector3f& dir, float t) const {
   RayHit out;
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return out;
   out.hit = true;
-  out.t = rh.ray.tfar;
-  Eigen::Vector3f n(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-  if (rh.hit.instID[0] != 0) {
-    const size_t k = rh.hit.instID[0] - 1;
+  out.t = t;
+  Eigen::Vector3f n = ng;
+  if (inst_id != 0) {
+    const size_t k = inst_id - 1;
     const Agent& agent = world_.agents[k];
-    out.surface = &agent.surfaces[agent.mesh.triangle_surface[rh.hit.primID]];
+    out.surface = &agent.surfaces[agent.mesh.triangle_surface[prim_id]];
     n = impl_->agent_rotations[k] * n;
   } else {
-    out.surface = &world_.surfaces[world_.mesh.triangle_surface[rh.hit.primID]];
+    out.surface = &world_.surfaces[world_.mesh.triangle_surface[prim_id]];
   }
   n.normalize();
   if (n.dot(dir) > 0) n = -n;
   out.normal = n;
   return out;
+}
+
+void RayScene::intersect8(const bool active[kPacket], const Eigen::Vector3f origin[kPacket],
+                          const Eigen::Vector3f dir[kPacket], float t_near, float t_far,
+                          RayHit out[kPacket]) const {
+  alignas(32) int valid[kPacket];
+  alignas(32) RTCRayHit8 rh;
+  for (int k = 0; k < kPacket; ++k) {
+    valid[k] = active[k] ? -1 : 0;
+    rh.ray.org_x[k] = origin[k].x();
+    rh.ray.org_y[k] = origin[k].y();
+    rh.ray.org_z[k] = origin[k].z();
+    rh.ray.dir_x[k] = dir[k].x();
+    rh.ray.dir_y[k] = dir[k].y();
+    rh.ray.dir_z[k] = dir[k].z();
+    rh.ray.tnear[k] = t_near;
+    rh.ray.tfar[k] = t_far;
+    rh.ray.time[k] = 0.0f;
+    rh.ray.mask[k] = 0xffffffff;
+    rh.ray.id[k] = static_cast<unsigned>(k);
+    rh.ray.flags[k] = 0;
+    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect8(valid, impl_->top, &context, &rh);
+  for (int k = 0; k < kPacket; ++k) {
+    if (!active[k] || rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
+      out[k] = RayHit{};
+      continue;
+    }
+    out[k] = hitFrom(rh.hit.instID[0][k], rh.hit.primID[k],
+                     {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]}, dir[k], rh.ray.tfar[k]);
+  }
+}
+
+void RayScene::occluded8(const bool active[kPacket], const Eigen::Vector3f origin[kPacket],
+                         const Eigen::Vector3f& dir, float t_near, float t_far,
+                         bool out[kPacket]) const {
+  alignas(32) int valid[kPacket];
+  alignas(32) RTCRay8 ray;
+  for (int k = 0; k < kPacket; ++k) {
+    valid[k] = active[k] ? -1 : 0;
+    ray.org_x[k] = origin[k].x();
+    ray.org_y[k] = origin[k].y();
+    ray.org_z[k] = origin[k].z();
+    ray.dir_x[k] = dir.x();
+    ray.dir_y[k] = dir.y();
+    ray.dir_z[k] = dir.z();
+    ray.tnear[k] = t_near;
+    ray.tfar[k] = t_far;
+    ray.time[k] = 0.0f;
+    ray.mask[k] = 0xffffffff;
+    ray.id[k] = static_cast<unsigned>(k);
+    ray.flags[k] = 0;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcOccluded8(valid, impl_->top, &context, &ray);
+  for (int k = 0; k < kPacket; ++k) out[k] = active[k] && ray.tfar[k] < 0.0f;
 }
 
 bool RayScene::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float t_near,

@@ -35,10 +35,22 @@ class RayScene {
   bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float t_near,
                 float t_far) const;
 
+  // Eight rays at once (Embree packets): neighbouring camera pixels traverse the same nodes, so
+  // tracing them together is much cheaper than one by one. Lanes with active[k] false are skipped.
+  static constexpr int kPacket = 8;
+  void intersect8(const bool active[kPacket], const Eigen::Vector3f origin[kPacket],
+                  const Eigen::Vector3f dir[kPacket], float t_near, float t_far,
+                  RayHit out[kPacket]) const;
+  void occluded8(const bool active[kPacket], const Eigen::Vector3f origin[kPacket],
+                 const Eigen::Vector3f& dir, float t_near, float t_far, bool out[kPacket]) const;
+
   const World& world() const { return world_; }
 
  private:
   struct Impl;
+  RayHit hitFrom(unsigned inst_id, unsigned prim_id, const Eigen::Vector3f& ng,
+                 const Eigen::Vector3f& dir, float t) const;
+
   const World& world_;
   std::unique_ptr<Impl> impl_;
 };

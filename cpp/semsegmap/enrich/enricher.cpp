@@ -1,0 +1,250 @@
+#include "semsegmap/enrich/enricher.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace semsegmap {
+
+namespace {
+
+std::string sizeText(const Image& im) {
+  return std::to_string(im.width) + "x" + std::to_string(im.height) + "x" +
+         std::to_string(im.channels);
+}
+
+// An image of the frame must be empty (that camera gives no colour / no class) or exactly the
+// camera's size with the expected channels; anything else is a mismatched rig and frame.
+void checkImage(const Frame& frame, const PinholeCamera& cam, const Image& im, int channels,
+                const char* what) {
+  if (im.empty()) return;
+  const bool ok = im.width == cam.width && im.height == cam.height && im.channels == channels &&
+                  im.data.size() == static_cast<size_t>(cam.width) * cam.height * channels;
+  if (!ok)
+    throw std::invalid_argument("frame " + std::to_string(frame.index) + ": camera '" + cam.name +
+                                "': " + what + " image is " + sizeText(im) + ", expected " +
+                                std::to_string(cam.width) + "x" + std::to_string(cam.height) + "x" +
+                                std::to_string(channels));
+}
+
+void checkInputs(const Frame& frame, const SensorRig& rig) {
+  const std::string where = "frame " + std::to_string(frame.index) + ": ";
+  if (!frame.cameras.empty() && frame.cameras.size() != rig.cameras.size()) {
+    std::string names;
+    for (const auto& c : rig.cameras) names += (names.empty() ? "'" : ", '") + c.name + "'";
+    throw std::invalid_argument(where + std::to_string(frame.cameras.size()) +
+                                " camera images but the rig has " +
+                                std::to_string(rig.cameras.size()) + " cameras (" + names + ")");
+  }
+  for (size_t c = 0; c < frame.cameras.size(); ++c) {
+    const PinholeCamera& cam = rig.cameras[c];
+    if (cam.width <= 0 || cam.height <= 0)
+      throw std::invalid_argument(where + "camera '" + cam.name + "': size " +
+                                  std::to_string(cam.width) + "x" + std::to_string(cam.height) +
+                                  " is not positive");
+    checkImage(frame, cam, frame.cameras[c].rgb, 3, "rgb");
+    checkImage(frame, cam, frame.cameras[c].label, 1, "label");
+  }
+  if (!frame.point_labels.empty() && frame.point_labels.size() != frame.points.size())
+    throw std::invalid_argument(where + std::to_string(frame.point_labels.size()) +
+                                " point labels for " + std::to_string(frame.points.size()) +
+                                " points");
+  // Corrupt input must not pass silently: a NaN would otherwise project nowhere and vanish.
+  for (size_t i = 0; i < frame.points.size(); ++i) {
+    const LidarPoint& p = frame.points[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw std::invalid_argument(where + "point " + std::to_string(i) +
+                                  " has a non-finite coordinate (" + std::to_string(p.x) + ", " +
+                                  std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
+  }
+}
+
+// One point seen by one camera. Each point is also projected from the LiDAR's origin with the
+// camera's orientation: the difference between the two is the camera/LiDAR parallax, the only
+// thing that lets a camera be blocked where the LiDAR saw through.
+struct Projection {
+  int32_t pixel;  // row-major index of the pixel containing (u, v), or -1 when not in the image;
+                  // the other fields are only set when it is
+  float u, v;     // camera pixel coordinates
+  float ul, vl;   // as seen from the LiDAR's origin; NaN when behind that viewpoint
+  float depth;    // z in the camera frame
+};
+
+struct CameraView {
+  std::vector<Projection> points;    // in frame order
+  std::vector<int32_t> nearest;      // z-buffer: per pixel, the nearest point projected there or -1
+  std::vector<float> nearest_depth;  // its depth (infinity when none), read first as it is dense
+};
+
+// Scratch reused from frame to frame by each calling thread: allocating and first touching
+// ~10 MB per frame costs as much as the projection itself.
+std::vector<CameraView>& scratchViews() {
+  static thread_local std::vector<CameraView> views;
+  return views;
+}
+
+// How far (pixels) the parallax must have moved a nearer point towards a point before the nearer
+// one is taken to block the camera's view of it. Without this, a surface seen at a grazing angle
+// hides itself: on a road 30 m away (simulated rig) two LiDAR rings are 2 pixels but 3 metres
+// apart, and the nearer ring would "occlude" the farther one although the camera sees the road
+// just as the LiDAR does.
+constexpr float kMinParallaxShiftPx = 1.0f;
+
+// The z-buffer test: a nearer point within `r` pixels (the neighbourhood fills the gaps between
+// the sparse LiDAR points of an occluder) that is nearer by more than the tolerance and that the
+// parallax moved towards this point, so that the camera sees it over this point's pixel.
+bool occluded(const CameraView& view, const PinholeCamera& cam, size_t i,
+              const EnrichmentConfig& config) {
+  const Projection& p = view.points[i];
+  const float nearer_than = p.depth - static_cast<float>(config.occlusion_tolerance_m +
+                                                         config.occlusion_tolerance_rel * p.depth);
+  const int r = config.occlusion_radius_px;
+  const int x = p.pixel % cam.width, y = p.pixel / cam.width;
+  const int x0 = std::max(0, x - r), x1 = std::min(cam.width - 1, x + r);
+  const int y0 = std::max(0, y - r), y1 = std::min(cam.height - 1, y + r);
+  for (int yy = y0; yy <= y1; ++yy) {
+    const size_t row = static_cast<size_t>(yy) * cam.width;
+    for (int xx = x0; xx <= x1; ++xx) {
+      if (view.nearest_depth[row + xx] >= nearer_than) continue;  // also when no point is there
+      const Projection& q = view.points[view.nearest[row + xx]];
+      // Seen from the LiDAR's origin one of them is behind: the parallax is huge.
+      if (std::isnan(q.ul) || std::isnan(p.ul)) return true;
+      const float apart_camera = std::hypot(q.u - p.u, q.v - p.v);
+      const float apart_lidar = std::hypot(q.ul - p.ul, q.vl - p.vl);
+      if (apart_lidar - apart_camera >= kMinParallaxShiftPx) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void rgbToHsv(uint8_t r, uint8_t g, uint8_t b, float& h, float& s, float& v) {
+  const int mx = std::max({r, g, b}), mn = std::min({r, g, b});
+  const int delta = mx - mn;
+  v = mx / 255.0f;
+  s = mx > 0 ? static_cast<float>(delta) / mx : 0.0f;
+  if (delta == 0) {
+    h = 0.0f;  // grey: hue undefined, 0 by convention
+    return;
+  }
+  float sector;  // hue in sixths of the circle, in [-1, 5)
+  if (mx == r)
+    sector = static_cast<float>(g - b) / delta;
+  else if (mx == g)
+    sector = 2.0f + static_cast<float>(b - r) / delta;
+  else
+    sector = 4.0f + static_cast<float>(r - g) / delta;
+  h = sector / 6.0f;
+  if (h < 0.0f) h += 1.0f;
+  // Hue is cyclic: a value that rounds up to 1 is the same colour as 0.
+  if (h >= 1.0f) h = 0.0f;
+}
+
+EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
+                          const EnrichmentConfig& config) {
+  checkInputs(frame, rig);
+  if (config.occlusion_radius_px < 0)
+    throw std::invalid_argument("enrichment: occlusion_radius_px must not be negative, got " +
+                                std::to_string(config.occlusion_radius_px));
+
+  const auto n = static_cast<std::ptrdiff_t>(frame.points.size());
+  const size_t n_cams = frame.cameras.size();  // 0 when the frame has no images at all
+
+  bool camera_semantics = false;
+  for (const auto& cf : frame.cameras) camera_semantics |= !cf.label.empty();
+  const bool point_semantics = !camera_semantics && !frame.point_labels.empty();
+
+  // Pass 1: project every point into every camera (each camera's own extrinsics).
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  std::vector<CameraView>& views = scratchViews();
+  if (views.size() < n_cams) views.resize(n_cams);
+  for (size_t c = 0; c < n_cams; ++c) views[c].points.resize(frame.points.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const LidarPoint& lp = frame.points[i];
+    const Eigen::Vector3d p(lp.x, lp.y, lp.z);
+    for (size_t c = 0; c < n_cams; ++c) {
+      const PinholeCamera& cam = rig.cameras[c];
+      Projection& pr = views[c].points[i];
+      const Eigen::Vector3d pc = cam.T_camera_lidar * p;
+      const auto uv = cam.project(pc);
+      pr.pixel = -1;
+      if (!uv || !cam.inImage(*uv)) continue;
+      // The pixel containing (u, v): pixel x covers [x, x + 1), the convention of inImage().
+      pr.pixel = static_cast<int32_t>(uv->y()) * cam.width + static_cast<int32_t>(uv->x());
+      pr.u = static_cast<float>(uv->x());
+      pr.v = static_cast<float>(uv->y());
+      pr.depth = static_cast<float>(pc.z());
+      const auto uvl = cam.project(cam.T_camera_lidar.linear() * p);
+      pr.ul = uvl ? static_cast<float>(uvl->x()) : kNaN;
+      pr.vl = uvl ? static_cast<float>(uvl->y()) : kNaN;
+    }
+  }
+
+  // Z-buffers: the nearest point per pixel, one camera per thread.
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_cams); ++c) {
+    CameraView& view = views[c];
+    const size_t pixels = static_cast<size_t>(rig.cameras[c].width) * rig.cameras[c].height;
+    view.nearest.assign(pixels, -1);
+    view.nearest_depth.assign(pixels, std::numeric_limits<float>::infinity());
+    for (std::ptrdiff_t i = 0; i < n; ++i) {
+      const Projection& pr = view.points[i];
+      if (pr.pixel < 0 || !(pr.depth < view.nearest_depth[pr.pixel])) continue;
+      view.nearest[pr.pixel] = static_cast<int32_t>(i);
+      view.nearest_depth[pr.pixel] = pr.depth;
+    }
+  }
+
+  // Pass 2: per point, the unoccluded camera whose image centre is nearest gives colour and class.
+  EnrichedCloud cloud(frame.points.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const LidarPoint& lp = frame.points[i];
+    EnrichedPoint& ep = cloud[i];
+    ep.x = lp.x;
+    ep.y = lp.y;
+    ep.z = lp.z;
+    if (!frame.point_labels.empty()) {
+      ep.instance_id = frame.point_labels[i].instance_id;
+      if (point_semantics) ep.class_id = frame.point_labels[i].class_id;
+    }
+
+    int best_cam = -1;
+    size_t best_pixel = 0;
+    double best_centre_dist = std::numeric_limits<double>::infinity();
+    for (size_t c = 0; c < n_cams; ++c) {
+      const Projection& pr = views[c].points[i];
+      if (pr.pixel < 0) continue;
+      const CameraFrame& cf = frame.cameras[c];
+      if (cf.rgb.empty() && cf.label.empty()) continue;  // this camera has nothing to give
+      const PinholeCamera& cam = rig.cameras[c];
+      if (occluded(views[c], cam, static_cast<size_t>(i), config)) continue;
+      // Distance to the image centre, relative to the half diagonal, so that cameras of
+      // different sizes compare fairly; lens effects are smallest near the centre.
+      const double du = pr.u - 0.5 * cam.width, dv = pr.v - 0.5 * cam.height;
+      const double d =
+          (du * du + dv * dv) / (0.25 * (static_cast<double>(cam.width) * cam.width +
+                                         static_cast<double>(cam.height) * cam.height));
+      if (d < best_centre_dist) {
+        best_centre_dist = d;
+        best_cam = static_cast<int>(c);
+        best_pixel = static_cast<size_t>(pr.pixel);
+      }
+    }
+    if (best_cam < 0) continue;
+    const CameraFrame& cf = frame.cameras[best_cam];
+    if (!cf.rgb.empty()) {
+      const uint8_t* rgb = cf.rgb.data.data() + best_pixel * 3;
+      rgbToHsv(rgb[0], rgb[1], rgb[2], ep.h, ep.s, ep.v);
+      ep.has_color = true;
+    }
+    if (camera_semantics && !cf.label.empty()) ep.class_id = cf.label.data[best_pixel];
+  }
+  return cloud;
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,110 @@
+#include "semsegmap/io/config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+namespace semsegmap {
+
+namespace {
+
+// A section is a table of key -> setter; anything not in the table is an error, so a typo in a
+// config never silently leaves a default in place.
+using Setter = std::function<void(const YAML::Node&)>;
+
+template <typename T>
+Setter set(T& field) {
+  return [&field](const YAML::Node& n) { field = n.as<T>(); };
+}
+
+void readSection(const std::filesystem::path& path, const YAML::Node& root, const std::string& name,
+                 const std::map<std::string, Setter>& keys) {
+  const YAML::Node section = root[name];
+  if (!section) return;
+  if (!section.IsMap())
+    throw std::runtime_error(path.string() + ": " + name + ": expected a mapping");
+  for (const auto& kv : section) {
+    const std::string key = kv.first.as<std::string>();
+    auto it = keys.find(key);
+    if (it == keys.end())
+      throw std::runtime_error(path.string() + ": " + name + "." + key + ": unknown key");
+    try {
+      it->second(kv.second);
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(path.string() + ": " + name + "." + key + ": wrong type (" + e.msg +
+                               ")");
+    }
+  }
+}
+
+}  // namespace
+
+PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path))
+    throw std::runtime_error(path.string() + ": no such config file");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path.string() + ": not valid YAML (" + e.msg + ")");
+  }
+  if (!root.IsMap())
+    throw std::runtime_error(path.string() + ": expected a mapping at the top level");
+  const std::map<std::string, bool> sections = {
+      {"enrichment", true}, {"local_map", true}, {"segmentation", true}};
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    if (!sections.count(key))
+      throw std::runtime_error(path.string() + ": " + key + ": unknown section");
+  }
+
+  PipelineConfig c;
+  readSection(path, root, "enrichment",
+              {{"occlusion_radius_px", set(c.enrichment.occlusion_radius_px)},
+               {"occlusion_tolerance_m", set(c.enrichment.occlusion_tolerance_m)},
+               {"occlusion_tolerance_rel", set(c.enrichment.occlusion_tolerance_rel)}});
+  auto& lm = c.local_map;
+  readSection(path, root, "local_map",
+              {{"voxel_size_m", set(lm.voxel_size_m)},
+               {"radius_m", set(lm.radius_m)},
+               {"min_points_per_voxel", set(lm.min_points_per_voxel)},
+               {"remove_dynamic_classes", set(lm.remove_dynamic_classes)},
+               {"remove_ground_classes", set(lm.remove_ground_classes)},
+               {"remove_unknown_class", set(lm.remove_unknown_class)},
+               {"geometric_ground_removal", set(lm.geometric_ground_removal)},
+               {"ground_cell_size_m", set(lm.ground.cell_size_m)},
+               {"ground_neighbourhood_cells", set(lm.ground.neighbourhood_cells)},
+               {"ground_height_above_m", set(lm.ground.height_above_m)}});
+  auto& sg = c.segmentation;
+  readSection(path, root, "segmentation",
+              {{"d_segment_m", set(sg.d_segment_m)},
+               {"hue_threshold", set(sg.hue_threshold)},
+               {"hue_penalty", set(sg.hue_penalty)},
+               {"class_penalty", set(sg.class_penalty)},
+               {"min_segment_points", set(sg.min_segment_points)},
+               {"max_segment_points", set(sg.max_segment_points)},
+               {"observation_growth", set(sg.observation_growth)},
+               {"keep_all_observation_points", set(sg.keep_all_observation_points)}});
+
+  auto check = [&](bool ok, const std::string& what) {
+    if (!ok) throw std::runtime_error(path.string() + ": " + what);
+  };
+  check(lm.voxel_size_m > 0, "local_map.voxel_size_m: must be positive");
+  check(lm.radius_m > lm.voxel_size_m, "local_map.radius_m: must exceed the voxel size");
+  check(lm.min_points_per_voxel >= 1, "local_map.min_points_per_voxel: must be at least 1");
+  check(sg.d_segment_m > 0, "segmentation.d_segment_m: must be positive");
+  check(sg.hue_threshold >= 0 && sg.hue_threshold <= 0.5,
+        "segmentation.hue_threshold: must be in [0, 0.5]");
+  check(sg.hue_penalty >= 0 && sg.class_penalty >= 0,
+        "segmentation: penalties must not be negative");
+  check(sg.min_segment_points <= sg.max_segment_points,
+        "segmentation.min_segment_points: must not exceed max_segment_points");
+  check(c.enrichment.occlusion_radius_px >= 0,
+        "enrichment.occlusion_radius_px: must not be negative");
+  return c;
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,14 @@
+// Reads the pipeline configuration (config/semsegmap.yaml, config/segmap.yaml) into the plain
+// config structs. The one place that knows YAML keys; unknown keys and wrong types are errors.
+#pragma once
+
+#include <filesystem>
+
+#include "semsegmap/pipeline/pipeline_config.h"
+
+namespace semsegmap {
+
+// Throws std::runtime_error "<file>: <section.key>: <what was wrong>".
+PipelineConfig loadPipelineConfig(const std::filesystem::path& path);
+
+}  // namespace semsegmap

@@ -1,0 +1,74 @@
+// The local map (paper section III-B): a voxel grid inside a cylinder of radius R around the
+// robot that moves with it. Points fuse into voxels (running centroid and colour, class votes);
+// dynamic and ground classes are filtered out; a voxel becomes active at a minimum point count,
+// and each update reports the voxels that became active and those that left the cylinder.
+#pragma once
+
+#include <unordered_map>
+#include <vector>
+
+#include "semsegmap/core/class_table.h"
+#include "semsegmap/core/enriched_point.h"
+#include "semsegmap/core/pose.h"
+#include "semsegmap/local_map/ground_removal.h"
+#include "semsegmap/local_map/voxel.h"
+
+namespace semsegmap {
+
+struct LocalMapConfig {
+  double voxel_size_m = 0.1;
+  double radius_m = 50.0;
+  uint32_t min_points_per_voxel = 1;
+  bool remove_dynamic_classes = true;  // person, car: the class table's dynamic flag
+  bool remove_ground_classes = true;   // road, sidewalk, terrain: the ground flag
+  // Points no camera saw (class unknown) in a scan that does carry semantics: without a class
+  // they cannot be filtered as ground or dynamic, and one stray ground patch glues every segment
+  // it touches into one.
+  bool remove_unknown_class = true;
+  // Geometric ground removal; always applied to scans without any semantics (data with no
+  // labels), and on request to labelled ones whose ground labels are not trusted.
+  bool geometric_ground_removal = false;
+  GroundRemovalConfig ground;
+};
+
+struct LocalMapUpdate {
+  std::vector<VoxelKey> newly_active;
+  std::vector<VoxelKey> removed;  // left the cylinder (only voxels that were active)
+  size_t points_inserted = 0;
+  size_t points_filtered = 0;
+};
+
+class LocalMap {
+ public:
+  LocalMap(const LocalMapConfig& config, const ClassTable& classes);
+
+  // Fuses one enriched scan (LiDAR frame) taken at T_map_lidar, then moves the cylinder to the
+  // robot's position `robot_xy` and drops what left it. `scan_has_semantics` is false for data
+  // with no labels at all: then every point is kept whatever its class and the ground is removed
+  // geometrically.
+  LocalMapUpdate update(const EnrichedCloud& scan, const Pose& T_map_lidar,
+                        const Eigen::Vector2d& robot_xy, bool scan_has_semantics = true);
+
+  const Voxel* find(VoxelKey key) const;
+  Eigen::Vector3i voxelIndex(const Eigen::Vector3f& p) const;
+  size_t size() const { return voxels_.size(); }
+  size_t activeCount() const { return active_count_; }
+  const LocalMapConfig& config() const { return config_; }
+  const std::unordered_map<VoxelKey, Voxel>& voxels() const { return voxels_; }
+
+ private:
+  void dropOutside(const Eigen::Vector2f& center, LocalMapUpdate& out);
+  uint64_t tileOf(const Eigen::Vector3i& voxel_index) const;
+
+  LocalMapConfig config_;
+  int tile_voxels_ = 20;
+  std::vector<uint8_t> drop_class_;  // by class id: dynamic or ground, per the config
+  std::unordered_map<VoxelKey, Voxel> voxels_;
+  // Voxels grouped by 2-D tile: moving the cylinder tests whole tiles and only looks at single
+  // voxels in the tiles its rim crosses, instead of sweeping every voxel every frame.
+  std::unordered_map<uint64_t, std::vector<VoxelKey>> tiles_;
+  size_t active_count_ = 0;
+  std::vector<uint8_t> ground_mask_;  // scratch, reused every update
+};
+
+}  // namespace semsegmap

@@ -1,0 +1,150 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "semsegmap/local_map/ground_removal.h"
+#include "semsegmap/local_map/local_map.h"
+
+using namespace semsegmap;
+
+namespace {
+
+EnrichedPoint point(float x, float y, float z, ClassId c = cls::kBuilding, float hue = 0.5f,
+                    bool colored = true) {
+  EnrichedPoint p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  p.h = hue;
+  p.s = 0.5f;
+  p.v = 0.5f;
+  p.class_id = c;
+  p.has_color = colored;
+  return p;
+}
+
+LocalMap makeMap(LocalMapConfig c = {}) {
+  return LocalMap(c, ClassTable::Default());
+}
+
+}  // namespace
+
+TEST(VoxelKey, PackUnpackRoundTrip) {
+  for (const Eigen::Vector3i& i : {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(-1, 2, -3),
+                                   Eigen::Vector3i(1000000, -1000000, 5)})
+    EXPECT_EQ(unpackVoxelKey(packVoxelKey(i)), i);
+  EXPECT_NE(packVoxelKey({1, 0, 0}), packVoxelKey({0, 1, 0}));
+}
+
+TEST(LocalMap, HueIsAveragedAsAnAngleAcrossTheWrap) {
+  LocalMap map = makeMap();
+  map.update({point(0.05f, 0.05f, 1.05f, cls::kBuilding, 0.95f),
+              point(0.05f, 0.05f, 1.05f, cls::kBuilding, 0.05f)},
+             Pose::Identity(), {0, 0});
+  ASSERT_EQ(map.size(), 1u);
+  const Voxel& v = map.voxels().begin()->second;
+  const float h = v.hue();
+  EXPECT_LT(std::min(h, 1.0f - h), 1e-4f) << h;  // 0.0, not the naive 0.5
+  EXPECT_EQ(v.n_points, 2u);
+  EXPECT_EQ(v.n_colored, 2u);
+  // Uncoloured points count for geometry, not for colour.
+  map.update({point(0.05f, 0.05f, 1.05f, cls::kBuilding, 0.5f, false)}, Pose::Identity(), {0, 0});
+  EXPECT_EQ(map.voxels().begin()->second.n_colored, 2u);
+  EXPECT_NEAR(map.voxels().begin()->second.centroid.x(), 0.05f, 1e-6f);
+}
+
+TEST(LocalMap, ClassVotesTakeTheMajorityWithoutOverflow) {
+  LocalMap map = makeMap();
+  EnrichedCloud scan;
+  for (int k = 0; k < 600; ++k) scan.push_back(point(0.01f, 0.01f, 1.01f, cls::kVegetation));
+  for (int k = 0; k < 300; ++k) scan.push_back(point(0.01f, 0.01f, 1.01f, cls::kFence));
+  map.update(scan, Pose::Identity(), {0, 0});
+  const Voxel& v = map.voxels().begin()->second;
+  EXPECT_EQ(v.semanticClass(), cls::kVegetation);
+  EXPECT_EQ(v.classes.countOf(cls::kVegetation), 600u);  // past 255: no 8-bit counters
+  EXPECT_EQ(v.classes.countOf(cls::kFence), 300u);
+}
+
+TEST(Votes, MajorityKeptWhenLabelsOutnumberSlots) {
+  Votes<ClassId, 4> votes;
+  for (int round = 0; round < 50; ++round) {
+    votes.add(7);
+    votes.add(7);
+    for (ClassId c = 20; c < 26; ++c)
+      if (round % 6 == c - 20) votes.add(c);
+  }
+  EXPECT_EQ(votes.majority().first, 7);
+}
+
+TEST(LocalMap, DynamicAndGroundClassesAreRemovedByConfiguration) {
+  LocalMap map = makeMap();
+  const LocalMapUpdate u = map.update(
+      {point(1, 0, 1, cls::kCar), point(2, 0, 0, cls::kRoad), point(3, 0, 0, cls::kTerrain),
+       point(4, 0, 1, cls::kPerson), point(5, 0, 1, cls::kBuilding)},
+      Pose::Identity(), {0, 0});
+  EXPECT_EQ(u.points_inserted, 1u);
+  EXPECT_EQ(u.points_filtered, 4u);
+  LocalMapConfig keep;
+  keep.remove_dynamic_classes = false;
+  keep.remove_ground_classes = false;
+  LocalMap all = makeMap(keep);
+  EXPECT_EQ(
+      all.update({point(1, 0, 1, cls::kCar), point(2, 0, 0, cls::kRoad)}, Pose::Identity(), {0, 0})
+          .points_inserted,
+      2u);
+}
+
+TEST(LocalMap, VoxelsActivateAtTheMinimumCountAndLeaveTheCylinder) {
+  LocalMapConfig c;
+  c.min_points_per_voxel = 3;
+  c.radius_m = 50.0;
+  LocalMap map = makeMap(c);
+  EXPECT_TRUE(
+      map.update({point(10.05f, 0.05f, 1.05f)}, Pose::Identity(), {0, 0}).newly_active.empty());
+  EXPECT_TRUE(
+      map.update({point(10.05f, 0.05f, 1.05f)}, Pose::Identity(), {0, 0}).newly_active.empty());
+  EXPECT_EQ(map.update({point(10.05f, 0.05f, 1.05f)}, Pose::Identity(), {0, 0}).newly_active.size(),
+            1u);
+  EXPECT_TRUE(
+      map.update({point(10.05f, 0.05f, 1.05f)}, Pose::Identity(), {0, 0}).newly_active.empty());
+  EXPECT_EQ(map.activeCount(), 1u);
+  // The robot drives 45 m away: still inside the 50 m cylinder.
+  EXPECT_TRUE(map.update({}, Pose::Identity(), {55, 0}).removed.empty());
+  // 65 m away: the voxel is dropped and reported.
+  const LocalMapUpdate u = map.update({}, Pose::Identity(), {75, 0});
+  ASSERT_EQ(u.removed.size(), 1u);
+  EXPECT_EQ(map.size(), 0u);
+  EXPECT_EQ(map.activeCount(), 0u);
+}
+
+TEST(LocalMap, PointsAreFusedInTheMapFrame) {
+  LocalMap map = makeMap();
+  const Pose T = planarPose(100.0, 50.0, 2.0, M_PI / 2);
+  map.update({point(1.0f, 0.0f, 0.0f)}, T, {100, 50});
+  ASSERT_EQ(map.size(), 1u);
+  const Eigen::Vector3f c = map.voxels().begin()->second.centroid;
+  EXPECT_NEAR(c.x(), 100.0f, 1e-4f);
+  EXPECT_NEAR(c.y(), 51.0f, 1e-4f);
+  EXPECT_NEAR(c.z(), 2.0f, 1e-4f);
+}
+
+TEST(GroundRemoval, FollowsATiltedGroundWithoutAFixedHeight) {
+  // A ground plane pitched by 8 degrees (a Segway leaning forward) and a 1 m box standing on it.
+  EnrichedCloud scan;
+  const double slope = std::tan(8.0 * M_PI / 180.0);
+  for (float x = -20; x <= 20; x += 0.25f)
+    for (float y = -10; y <= 10; y += 0.25f)
+      scan.push_back(point(x, y, static_cast<float>(slope * x), cls::kUnknown));
+  const size_t ground_points = scan.size();
+  for (float z = 0.3f; z <= 1.0f; z += 0.1f)
+    for (float y = -0.5f; y <= 0.5f; y += 0.1f)
+      scan.push_back(point(15.0f, y, static_cast<float>(slope * 15.0 + z), cls::kUnknown));
+  const auto ground = markGround(scan, Pose::Identity(), GroundRemovalConfig{});
+  size_t ground_hits = 0, object_hits = 0;
+  for (size_t k = 0; k < scan.size(); ++k)
+    (k < ground_points ? ground_hits : object_hits) += ground[k];
+  EXPECT_GT(ground_hits, ground_points * 98 / 100);
+  EXPECT_EQ(object_hits, 0u);
+  // A fixed height threshold would have removed the box (it stands 2 m above the origin's ground).
+  EXPECT_GT(slope * 15.0, 2.0);
+}
