@@ -13,7 +13,7 @@ endif
 .PHONY: setup build test demo bench format clean
 
 setup:
-	./scripts/setup.sh
+	bash scripts/setup.sh
 
 build: setup
 	cmake -S . -B $(BUILD) $(CMAKE_FLAGS)
