@@ -31,5 +31,7 @@ int runDemo(const std::vector<std::string>& args);
 int runEnrich(const std::vector<std::string>& args);
 int runConvert(const std::vector<std::string>& args);
 int runSegment(const std::vector<std::string>& args);
+int runTrain(const std::vector<std::string>& args);
+int runEval(const std::vector<std::string>& args);
 
 }  // namespace semsegmap::app

@@ -23,6 +23,16 @@ commands:
                      any dataset written in the project's format
   segment            --dataset SPEC --config FILE --out DIR [--poses gt|odom] [--max-frames K]
                      enrichment + local map + incremental segmentation -> segments.csv/.ply/.png
+  train              --descriptor semsegmap-net|segmap-cnn --dataset SPEC[,SPEC...] --out FILE
+                     [--epochs N] [--batch N] [--threads N] [--config FILE] [--max-frames K]
+                     [--cache FILE] [--anchors-per-epoch N] [--lr X] [--seed N] [--points N]
+                     trains a learned descriptor on simulated ground truth; a key=value after
+                     a sim: spec belongs to it, any other item starts a new spec (';' also
+                     separates): sim:world=1,run=S1,sim:world=1,run=S1,condition=sunrise
+  eval descriptors   --world-seed N --out DIR [--preset full|small|tiny] [--run S0]
+                     [--max-frames K] [--config FILE] [--models DIR] [--descriptors LIST]
+                     rank of each segment's final observation for its earlier ones, per
+                     completeness band, for each descriptor -> DIR/descriptors.json
   demo               [--out DIR]   the main job on simulated data
 
 datasets (SPEC): DIR (project format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,
@@ -41,6 +51,8 @@ int main(int argc, char** argv) {
       {"enrich", semsegmap::app::runEnrich},
       {"convert", semsegmap::app::runConvert},
       {"segment", semsegmap::app::runSegment},
+      {"train", semsegmap::app::runTrain},
+      {"eval", semsegmap::app::runEval},
       {"demo", semsegmap::app::runDemo},
   };
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {

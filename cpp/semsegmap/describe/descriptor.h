@@ -1,0 +1,48 @@
+// Segment descriptors (paper section III-C): one interface, batched, for the learned SemSegMap
+// network, the SegMap CNN baseline, and the eigenvalue and FPFH baselines.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "semsegmap/segment/segment.h"
+
+namespace semsegmap {
+
+enum class DescriptorKind { kEigen, kFpfh, kSegMapCnn, kSemSegMapNet };
+
+// "eigen", "fpfh", "segmap-cnn", "semsegmap-net"; parse throws std::invalid_argument.
+std::string descriptorName(DescriptorKind kind);
+DescriptorKind parseDescriptorKind(const std::string& name);
+
+// What a descriptor sees of a segment observation: its points (map frame, with colour and
+// class) and its size in points (the triplet loss weighs pairs by the ratio of the two).
+struct DescriptorInput {
+  const EnrichedCloud* points = nullptr;
+};
+
+class Describer {
+ public:
+  virtual ~Describer() = default;
+  virtual DescriptorKind kind() const = 0;
+  virtual int dimension() const = 0;
+  // Identifies the exact model (weights) so that a target map built with one model is never
+  // queried with descriptors of another; constant for the hand-made descriptors.
+  virtual std::string fingerprint() const = 0;
+  // One row per input, in order. Thread-compatible: one Describer per thread.
+  virtual Eigen::MatrixXf describe(const std::vector<DescriptorInput>& batch) = 0;
+};
+
+struct DescriberOptions {
+  std::string model_path;  // required for the learned descriptors
+  int threads = 0;         // 0: all cores
+};
+
+// Throws std::runtime_error naming the model file when it is missing, truncated or of another
+// descriptor kind.
+std::unique_ptr<Describer> makeDescriber(DescriptorKind kind, const DescriberOptions& options);
+
+}  // namespace semsegmap

@@ -1,0 +1,33 @@
+// Names of the descriptor kinds as they appear in configs, map files and on the command line.
+#include <stdexcept>
+
+#include "semsegmap/describe/descriptor.h"
+
+namespace semsegmap {
+
+std::string descriptorName(DescriptorKind kind) {
+  switch (kind) {
+    case DescriptorKind::kEigen:
+      return "eigen";
+    case DescriptorKind::kFpfh:
+      return "fpfh";
+    case DescriptorKind::kSegMapCnn:
+      return "segmap-cnn";
+    case DescriptorKind::kSemSegMapNet:
+      return "semsegmap-net";
+  }
+  // Only reachable through a cast of an out-of-range integer.
+  throw std::invalid_argument("descriptorName: invalid DescriptorKind value " +
+                              std::to_string(static_cast<int>(kind)));
+}
+
+DescriptorKind parseDescriptorKind(const std::string& name) {
+  for (const DescriptorKind kind : {DescriptorKind::kEigen, DescriptorKind::kFpfh,
+                                    DescriptorKind::kSegMapCnn, DescriptorKind::kSemSegMapNet}) {
+    if (descriptorName(kind) == name) return kind;
+  }
+  throw std::invalid_argument("unknown descriptor '" + name +
+                              "' (expected eigen, fpfh, segmap-cnn or semsegmap-net)");
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,29 @@
+// Inference with a trained segmap-cnn or semsegmap-net model file behind the Describer
+// interface: what the pipeline's describe stage calls for the learned kinds.
+#pragma once
+
+#include <memory>
+
+#include "semsegmap/describe/descriptor.h"
+
+namespace semsegmap {
+
+// Loads options.model_path (throws std::runtime_error naming the file when it is missing,
+// corrupt or holds another kind; std::invalid_argument for a hand-made kind). The describer
+// splits a batch into chunks of at most kLearnedChunk segments for options.threads threads of
+// its own (0: all cores), each running torch single-threaded (eval mode, no autograd), and
+// subsamples every segment with the same fixed salt: a segment always gets the same
+// descriptor, whatever its batch or the order of its points.
+std::unique_ptr<Describer> makeLearnedDescriber(DescriptorKind kind,
+                                                const DescriberOptions& options);
+
+constexpr int kLearnedChunk = 64;
+
+// glibc's malloc: allocations up to 32 MB come from the heap, and up to 512 MB of freed heap stay
+// with the process. Every batch allocates and frees tens of MB of activations; with glibc's
+// defaults they go back to the system and fault back in page by page, which measured 40-50 % of
+// the inference time. Process-wide, idempotent, a no-op elsewhere than glibc;
+// makeLearnedDescriber calls it, and training gains the same from it.
+void keepFreedMemoryForTorch();
+
+}  // namespace semsegmap

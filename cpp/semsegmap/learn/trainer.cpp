@@ -1,0 +1,294 @@
+#include "semsegmap/learn/trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+namespace semsegmap {
+
+namespace {
+
+void checkConfig(const TrainConfig& c) {
+  auto fail = [](const std::string& what) { throw std::invalid_argument("training: " + what); };
+  if (c.net.kind != DescriptorKind::kSemSegMapNet && c.net.kind != DescriptorKind::kSegMapCnn)
+    fail("descriptor '" + descriptorName(c.net.kind) +
+         "' is not learned (expected semsegmap-net or segmap-cnn)");
+  validateNetConfig(c.net);
+  if (c.epochs < 1) fail("epochs must be at least 1");
+  if (c.batch_size < 1) fail("batch size must be at least 1");
+  if (!(c.learning_rate > 0)) fail("learning rate must be positive");
+  if (!(c.learning_rate_decay > 0)) fail("learning rate decay must be positive");
+  if (c.threads < 1) fail("threads must be at least 1");
+  if (c.warmup_epochs < 0) fail("warm-up epochs must not be negative");
+  if (c.hard_negative_candidates < 1) fail("hard-negative candidates must be at least 1");
+  if (!(c.validation_fraction >= 0 && c.validation_fraction < 1))
+    fail("validation fraction must be in [0, 1)");
+  if (!(c.max_sigma > 0)) fail("max sigma must be positive");
+}
+
+// Copies of the weights of the best epoch, so that the result does not depend on a file.
+struct Snapshot {
+  std::vector<torch::Tensor> tensors;
+  void take(DescriptorNetImpl& net) {
+    tensors.clear();
+    for (const auto& t : net.parameters()) tensors.push_back(t.detach().clone());
+    for (const auto& t : net.buffers()) tensors.push_back(t.detach().clone());
+  }
+  void restore(DescriptorNetImpl& net) const {
+    if (tensors.empty()) return;
+    torch::NoGradGuard no_grad;
+    size_t k = 0;
+    for (auto& t : net.parameters()) t.copy_(tensors[k++]);
+    for (auto& t : net.buffers()) t.copy_(tensors[k++]);
+  }
+};
+
+struct Mean {
+  double sum = 0.0;
+  size_t n = 0;
+  void add(double v) { sum += v, ++n; }
+  double value() const { return n ? sum / n : 0.0; }
+};
+
+struct BatchLoss {
+  torch::Tensor triplet, reconstruction;
+  torch::Tensor descriptors;  // [3B, D]: anchors, positives, negatives
+};
+
+// The loss of one batch of triplets. Only the anchors are decoded: the decoder costs more than
+// the encoder (twice as much for semsegmap-net, twenty times for segmap-cnn), and the loss
+// reconstructs the anchor.
+BatchLoss batchLoss(DescriptorNetImpl& net, const TrainingSet& data, const std::vector<Triplet>& t,
+                    const TrainConfig& config, bool augmented, std::mt19937& rng) {
+  const size_t batch = t.size();
+  std::vector<EnrichedCloud> clouds;
+  clouds.reserve(3 * batch);
+  std::vector<double> effective_points;
+  for (size_t role = 0; role < 3; ++role)
+    for (const Triplet& x : t) {
+      const size_t i = role == 0 ? x.anchor : role == 1 ? x.positive : x.negative;
+      const TrainingObservation& o = data.observations.at(i);
+      clouds.push_back(augmented ? augment(o.cloud(), config.augmentation, rng) : o.cloud());
+      // Points of the whole observation that survived the augmentation's cuts and drops.
+      effective_points.push_back(static_cast<double>(o.n_points) *
+                                 static_cast<double>(clouds.back().size()) /
+                                 static_cast<double>(std::max<size_t>(1, o.size())));
+    }
+  std::vector<float> sigma(batch);
+  for (size_t b = 0; b < batch; ++b)
+    sigma[b] = static_cast<float>(std::min(
+        config.max_sigma, effective_points[batch + b] / std::max(1.0, effective_points[b])));
+  std::vector<const EnrichedCloud*> anchors, others;
+  for (size_t i = 0; i < clouds.size(); ++i) (i < batch ? anchors : others).push_back(&clouds[i]);
+
+  const NetInput anchor_input = makeNetInput(config.net, anchors, rng);
+  const NetOutput anchor_output = net.forward(anchor_input);
+  const torch::Tensor other = net.encode(makeNetInput(config.net, others, rng));
+  const int64_t B = static_cast<int64_t>(batch);
+  BatchLoss loss;
+  loss.triplet =
+      tripletLoss(anchor_output.descriptor, other.slice(0, 0, B), other.slice(0, B, 2 * B),
+                  torch::from_blob(sigma.data(), {B}, torch::kFloat).clone(), config.margin);
+  loss.reconstruction = torch::binary_cross_entropy_with_logits(anchor_output.reconstruction,
+                                                                anchor_input.target_occupancy);
+  loss.descriptors = torch::cat({anchor_output.descriptor, other});
+  return loss;
+}
+
+}  // namespace
+
+Eigen::MatrixXf describeObservations(DescriptorNetImpl& net, const TrainingSet& data,
+                                     const std::vector<size_t>& which, uint64_t seed,
+                                     int batch_size) {
+  const bool was_training = net.is_training();
+  net.eval();
+  torch::NoGradGuard no_grad;
+  Eigen::MatrixXf out(static_cast<Eigen::Index>(which.size()), net.config().descriptor_dim);
+  for (size_t start = 0; start < which.size(); start += static_cast<size_t>(batch_size)) {
+    const size_t end = std::min(which.size(), start + static_cast<size_t>(batch_size));
+    std::vector<EnrichedCloud> clouds;
+    clouds.reserve(end - start);
+    for (size_t i = start; i < end; ++i) clouds.push_back(data.observations.at(which[i]).cloud());
+    std::vector<const EnrichedCloud*> ptrs;
+    for (const auto& c : clouds) ptrs.push_back(&c);
+    // One salt for all: an observation's input does not depend on the batch it is in.
+    const std::vector<uint64_t> salts(ptrs.size(), seed);
+    const torch::Tensor d =
+        net.encode(makeNetInput(net.config(), ptrs, salts)).to(torch::kFloat).contiguous();
+    const float* dp = d.data_ptr<float>();
+    for (size_t i = start; i < end; ++i)
+      out.row(static_cast<Eigen::Index>(i)) =
+          Eigen::Map<const Eigen::RowVectorXf>(dp + (i - start) * out.cols(), out.cols());
+  }
+  if (was_training) net.train();
+  return out;
+}
+
+RetrievalAccuracy validationAccuracy(DescriptorNetImpl& net, const TrainingSet& data,
+                                     const std::vector<size_t>& which, uint64_t seed,
+                                     size_t max_queries) {
+  const std::vector<int> labels = landmarkLabels(data);
+  const std::vector<bool> final = finalObservations(data);
+  std::vector<size_t> queries, database;
+  for (size_t i : which)
+    if (!final.at(i)) queries.push_back(i);
+  for (size_t i = 0; i < final.size(); ++i)
+    if (final[i]) database.push_back(i);
+  if (queries.size() > max_queries) {
+    std::mt19937 pick(static_cast<uint32_t>(seed));
+    std::shuffle(queries.begin(), queries.end(), pick);
+    queries.resize(max_queries);
+    std::sort(queries.begin(), queries.end());
+  }
+  auto labelsOf = [&](const std::vector<size_t>& idx) {
+    std::vector<int> out;
+    for (size_t i : idx) out.push_back(labels[i]);
+    return out;
+  };
+  return retrievalAccuracy(describeObservations(net, data, queries, seed), labelsOf(queries),
+                           describeObservations(net, data, database, seed), labelsOf(database));
+}
+
+double evaluateTriplets(DescriptorNetImpl& net, const TrainingSet& data,
+                        const std::vector<Triplet>& triplets, const TrainConfig& config) {
+  const bool was_training = net.is_training();
+  net.eval();
+  torch::NoGradGuard no_grad;
+  std::mt19937 rng(static_cast<uint32_t>(config.seed));
+  Mean mean;
+  const size_t batch = static_cast<size_t>(std::max(1, config.batch_size));
+  for (size_t start = 0; start < triplets.size(); start += batch) {
+    const std::vector<Triplet> part(
+        triplets.begin() + static_cast<std::ptrdiff_t>(start),
+        triplets.begin() + static_cast<std::ptrdiff_t>(std::min(triplets.size(), start + batch)));
+    const BatchLoss loss = batchLoss(net, data, part, config, false, rng);
+    const double value =
+        (loss.triplet + config.reconstruction_weight * loss.reconstruction).item<double>();
+    for (size_t k = 0; k < part.size(); ++k) mean.add(value);  // weighted by batch size
+  }
+  if (was_training) net.train();
+  return mean.value();
+}
+
+TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
+                            const std::filesystem::path& out, const TrainCallbacks& callbacks) {
+  checkConfig(config);
+  torch::set_num_threads(config.threads);
+  torch::manual_seed(config.seed);
+  std::mt19937 rng(static_cast<uint32_t>(config.seed));
+
+  TrainResult result;
+  const TrainValSplit split = splitByInstance(data, config.validation_fraction, config.split_seed);
+  const PairSampler sampler(data, split.train);
+  result.train_observations = split.train.size();
+  result.validation_observations = split.validation.size();
+  result.anchors = sampler.anchors().size();
+  if (sampler.anchors().empty())
+    throw std::runtime_error(
+        "training data has no instance observed twice: nothing to learn from (more frames?)");
+
+  auto net = makeNet(config.net);
+  net->train();
+  torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(config.learning_rate));
+  double learning_rate = config.learning_rate;
+
+  // Descriptors of the training observations as last computed (during training, so at most an
+  // epoch old and augmented): the hard-negative miner ranks candidates by them for free.
+  const int dim = config.net.descriptor_dim;
+  Eigen::MatrixXf cached(static_cast<Eigen::Index>(data.observations.size()), dim);
+  std::vector<char> is_cached(data.observations.size(), 0);
+  auto cachedDistance = [&](size_t a, size_t b) {
+    return is_cached[b] ? (cached.row(static_cast<Eigen::Index>(b)) -
+                           cached.row(static_cast<Eigen::Index>(a)))
+                              .squaredNorm()
+                        : std::numeric_limits<float>::infinity();
+  };
+
+  const size_t batch =
+      std::min<size_t>(static_cast<size_t>(config.batch_size), sampler.anchors().size());
+  const size_t anchors_per_epoch =
+      config.anchors_per_epoch > 0 ? config.anchors_per_epoch : sampler.anchors().size();
+  const size_t steps = std::max<size_t>(1, anchors_per_epoch / batch);
+  std::vector<size_t> order;  // anchors still to visit; refilled and shuffled when empty
+
+  Snapshot best;
+  double best_score = -std::numeric_limits<double>::infinity();
+  for (int epoch = 1; epoch <= config.epochs; ++epoch) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool mine = epoch > config.warmup_epochs;
+    Mean loss_mean, triplet_mean, recon_mean;
+    for (size_t step = 0; step < steps; ++step) {
+      std::vector<Triplet> triplets(batch);
+      for (Triplet& t : triplets) {
+        if (order.empty()) {
+          order = sampler.anchors();
+          std::shuffle(order.begin(), order.end(), rng);
+        }
+        t.anchor = order.back();
+        order.pop_back();
+        t.positive = sampler.positive(t.anchor, rng);
+        t.negative = sampler.negative(t.anchor, rng);
+        if (!mine || !is_cached[t.anchor]) continue;
+        float hardest = cachedDistance(t.anchor, t.negative);
+        for (int k = 1; k < config.hard_negative_candidates; ++k) {
+          const size_t c = sampler.negative(t.anchor, rng);
+          const float d = cachedDistance(t.anchor, c);
+          if (d < hardest) hardest = d, t.negative = c;
+        }
+      }
+
+      const BatchLoss b = batchLoss(*net, data, triplets, config, config.augment, rng);
+      const torch::Tensor loss = b.triplet + config.reconstruction_weight * b.reconstruction;
+      optimizer.zero_grad();
+      loss.backward();
+      optimizer.step();
+
+      const torch::Tensor d = b.descriptors.detach().to(torch::kFloat).contiguous();
+      const float* dp = d.data_ptr<float>();
+      for (size_t r = 0; r < 3 * batch; ++r) {
+        const Triplet& t = triplets[r % batch];
+        const size_t i = r < batch ? t.anchor : r < 2 * batch ? t.positive : t.negative;
+        cached.row(static_cast<Eigen::Index>(i)) =
+            Eigen::Map<const Eigen::RowVectorXf>(dp + r * static_cast<size_t>(dim), dim);
+        is_cached[i] = 1;
+      }
+      loss_mean.add(loss.item<double>());
+      triplet_mean.add(b.triplet.item<double>());
+      recon_mean.add(b.reconstruction.item<double>());
+      if (callbacks.step) callbacks.step(epoch, step + 1, steps, loss_mean.value());
+    }
+
+    EpochStats stats;
+    stats.epoch = epoch;
+    stats.loss = loss_mean.value();
+    stats.triplet_loss = triplet_mean.value();
+    stats.reconstruction_loss = recon_mean.value();
+    stats.learning_rate = learning_rate;
+    stats.validation = validationAccuracy(*net, data, split.validation, config.seed,
+                                          config.max_validation_queries);
+    // Without validation queries (tiny data), the training loss is all there is to go by.
+    const double score = stats.validation.queries > 0 ? stats.validation.top1 : -stats.loss;
+    if (score > best_score) {
+      best_score = score;
+      best.take(*net);
+      result.best_epoch = epoch;
+      stats.best = true;
+      if (!out.empty()) saveNet(out, *net);
+    }
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    result.history.push_back(stats);
+    if (callbacks.epoch) callbacks.epoch(stats);
+
+    learning_rate *= config.learning_rate_decay;
+    for (auto& group : optimizer.param_groups())
+      static_cast<torch::optim::AdamOptions&>(group.options()).lr(learning_rate);
+  }
+  best.restore(*net);
+  result.net = net;
+  return result;
+}
+
+}  // namespace semsegmap

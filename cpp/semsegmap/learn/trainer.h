@@ -1,0 +1,100 @@
+// Training of the learned descriptors (semsegmap-net, segmap-cnn) on simulated ground-truth
+// associations: the paper's triplet loss with sigma = points(P) / points(A) plus the decoder's
+// per-voxel reconstruction loss, Adam, augmented observations, random negatives during warm-up
+// and then the hardest of a few, and the best epoch chosen by validation retrieval accuracy.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "semsegmap/describe/learned_net.h"
+#include "semsegmap/learn/augment.h"
+#include "semsegmap/learn/training_data.h"
+
+namespace semsegmap {
+
+struct TrainConfig {
+  NetConfig net;  // net.kind: kSemSegMapNet or kSegMapCnn
+  int epochs = 12;
+  int batch_size = 32;               // triplets a step (the network sees 3x as many observations)
+  size_t anchors_per_epoch = 0;      // 0: every training observation that has a positive
+  double learning_rate = 1e-3;       // Adam
+  double learning_rate_decay = 1.0;  // multiplies the learning rate after every epoch
+  double margin = 0.4;               // the paper's m
+  double reconstruction_weight = 0.1;
+  // sigma = points(P) / points(A) is capped: a 100-point anchor with a 10000-point positive
+  // would otherwise weigh a hundred times the rest of its batch.
+  double max_sigma = 4.0;
+  int warmup_epochs = 1;  // random negatives; afterwards the hardest of the candidates below
+  int hard_negative_candidates = 8;
+  double validation_fraction = 0.1;      // of the instances
+  uint64_t split_seed = 1;               // which instances are held out
+  size_t max_validation_queries = 4000;  // random subset beyond (retrieval is quadratic)
+  int threads = 2;                       // torch::set_num_threads
+  uint64_t seed = 1;  // weights, sampling, augmentation: the same seed gives the same model
+  bool augment = true;
+  AugmentConfig augmentation;
+};
+
+struct EpochStats {
+  int epoch = 0;                                                     // from 1
+  double loss = 0.0, triplet_loss = 0.0, reconstruction_loss = 0.0;  // means over the epoch
+  RetrievalAccuracy validation;
+  double learning_rate = 0.0;
+  double seconds = 0.0;  // training and validation
+  bool best = false;     // the best so far (and saved)
+};
+
+struct TrainResult {
+  std::shared_ptr<DescriptorNetImpl> net;  // with the weights of the best epoch
+  std::vector<EpochStats> history;
+  int best_epoch = 0;
+  size_t train_observations = 0, validation_observations = 0, anchors = 0;
+};
+
+struct TrainCallbacks {
+  // After every step: epoch (from 1), steps done in it, steps in it, mean loss so far.
+  std::function<void(int, size_t, size_t, double)> step;
+  std::function<void(const EpochStats&)> epoch;
+};
+
+// Trains a new network on `data`. The best epoch is the one of highest validation top-1 (the
+// lowest training loss when the validation half has no query); when `out` is not empty it is
+// saved there with saveNet each time it improves. Throws std::invalid_argument on a bad config
+// and std::runtime_error when the data has no instance seen twice.
+TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
+                            const std::filesystem::path& out = {},
+                            const TrainCallbacks& callbacks = {});
+
+// Descriptors (one row each) of data.observations[which[i]], unaugmented, in eval mode; the
+// subsampling of the points is seeded by `seed`.
+Eigen::MatrixXf describeObservations(DescriptorNetImpl& net, const TrainingSet& data,
+                                     const std::vector<size_t>& which, uint64_t seed,
+                                     int batch_size = 64);
+
+// Validation retrieval accuracy of `net`, as a localization would use the descriptor: the final
+// (most complete) observation of every segment in `data` forms the database (the target map; the
+// training landmarks are its distractors), and every earlier observation among `which` is a
+// query that must find its landmark (landmarkLabels) there. Comparing every observation with
+// every other instead would be trivial with several runs on one trajectory: the other
+// condition's observation of a segment at the same frame has the same points, only other
+// colours. At most `max_queries`, a fixed random subset.
+RetrievalAccuracy validationAccuracy(DescriptorNetImpl& net, const TrainingSet& data,
+                                     const std::vector<size_t>& which, uint64_t seed,
+                                     size_t max_queries = 4000);
+
+struct Triplet {
+  size_t anchor = 0, positive = 0, negative = 0;  // indices into TrainingSet::observations
+};
+
+// The training loss (triplet + weighted reconstruction) of `net` on fixed triplets, unaugmented,
+// in eval mode and with subsampling seeded by config.seed: a yardstick that does not move with
+// the sampling of the batches.
+double evaluateTriplets(DescriptorNetImpl& net, const TrainingSet& data,
+                        const std::vector<Triplet>& triplets, const TrainConfig& config);
+
+}  // namespace semsegmap

@@ -1,0 +1,149 @@
+// Training data of the learned descriptors (paper section IV: trained only on simulated ground
+// truth): every observation of every segment, with the ground-truth instance its points belong
+// to, extracted by running the pipeline with ground-truth poses. Observations of one instance,
+// from any run or lighting condition, are positives of each other.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "semsegmap/core/enriched_point.h"
+#include "semsegmap/core/frame_source.h"
+#include "semsegmap/pipeline/pipeline_config.h"
+
+namespace semsegmap {
+
+// One segment observation, stored compactly: 27 bytes a point instead of sizeof(EnrichedPoint).
+struct TrainingObservation {
+  uint16_t instance = 0;                               // majority ground-truth instance
+  ClassId majority_class = cls::kUnknown;              //
+  uint16_t source = 0;                                 // index into TrainingSet::sources
+  int64_t segment = 0;                                 // segment id within that source's run
+  uint32_t n_points = 0;                               // before subsampling (the loss's sigma)
+  float purity = 0.0f;                                 // share of the points of `instance`
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();  // map frame
+  std::vector<float> xyzhsv;                           // 6 floats a stored point, map frame
+  std::vector<ClassId> classes;                        // a class a stored point
+  std::vector<uint8_t> colored;                        // has_color a stored point
+
+  size_t size() const { return classes.size(); }
+  EnrichedCloud cloud() const;  // instance_id of the points is `instance`
+};
+
+struct TrainingSet {
+  std::vector<std::string> sources;  // dataset specs
+  std::vector<TrainingObservation> observations;
+};
+
+struct ExtractionConfig {
+  float min_purity = 0.8f;  // observations at or below this purity are ambiguous labels
+  // Instances from here on are traffic (sim::kTrafficInstanceBase): a parked car whose points
+  // the cameras mislabelled as building survives the dynamic-class filter, but it is no
+  // landmark, and another traffic seed puts other cars there.
+  uint16_t first_transient_instance = 60000;
+  size_t max_frames = 0;  // per dataset; 0: all frames
+  // Larger observations keep a random subset: memory stays bounded, and the networks see at
+  // most a few thousand points anyway (semsegmap-net subsamples to NetConfig::num_points).
+  size_t max_points_per_observation = 4096;
+  uint64_t seed = 1;
+};
+
+// Called after each frame with (frames done, frames in this dataset, dataset index).
+using ExtractionProgress = std::function<void(size_t, size_t, size_t)>;
+
+// Runs the pipeline (ground-truth poses, keep_all_observation_points forced on) over `source`
+// and appends the kept observations of every segment to `out`, tagged with `source_index`.
+void appendObservations(FrameSource& source, uint16_t source_index, PipelineConfig pipeline,
+                        const ExtractionConfig& config, TrainingSet& out,
+                        const ExtractionProgress& progress = {});
+
+// openDataset() on each spec, then appendObservations. Throws when a dataset has no ground-truth
+// poses or no point instances (nothing to learn from).
+TrainingSet extractTrainingSet(const std::vector<std::string>& specs,
+                               const PipelineConfig& pipeline, const ExtractionConfig& config,
+                               const ExtractionProgress& progress = {});
+
+// A comma-separated list of dataset specs, where a sim spec has commas of its own: a token of
+// the form key=value (no '/' or ':') continues the sim: spec before it, any other token starts a
+// new spec; ';' always separates. "sim:world=1,run=S1,sim:world=1,run=S1,condition=sunrise"
+// is two specs. Throws std::invalid_argument on an empty list or an empty spec.
+std::vector<std::string> splitDatasetSpecs(const std::string& list);
+
+// The cache of extracted observations, so that a second training run does not re-run the
+// simulator. `provenance` says what the data was made from (specs, configuration); read returns
+// nullopt when the file is missing or was made from something else, and throws naming the file
+// when it is truncated or corrupt. Written to a temporary name and renamed.
+void writeTrainingCache(const std::filesystem::path& path, const TrainingSet& set,
+                        const std::string& provenance);
+std::optional<TrainingSet> readTrainingCache(const std::filesystem::path& path,
+                                             const std::string& provenance);
+
+// ---- Pairs, negatives and the validation split -------------------------------------------------
+
+// What a descriptor must find again: the observations of one instance of one majority class (a
+// tree's trunk and crown are one instance but two segments, never matched to each other).
+// Dense labels 0..L-1, one per observation.
+std::vector<int> landmarkLabels(const TrainingSet& set);
+
+// Validation instances are chosen by a hash of the instance id, never by observation, so that
+// no object is seen in training and validation; the same instance goes to the same half
+// whatever the data set.
+bool isValidationInstance(uint16_t instance, double validation_fraction, uint64_t seed);
+
+struct TrainValSplit {
+  std::vector<size_t> train, validation;  // indices into TrainingSet::observations
+};
+TrainValSplit splitByInstance(const TrainingSet& set, double validation_fraction, uint64_t seed);
+
+// Positives and negatives among a subset of the observations (one half of the split).
+class PairSampler {
+ public:
+  PairSampler(const TrainingSet& set, std::vector<size_t> subset);
+
+  // Observations that have at least one positive: the anchors of an epoch.
+  const std::vector<size_t>& anchors() const { return anchors_; }
+  // Another observation of the same landmark (requires hasPositive).
+  size_t positive(size_t anchor, std::mt19937& rng) const;
+  bool hasPositive(size_t anchor) const;
+  // An observation of another instance, uniformly.
+  size_t negative(size_t anchor, std::mt19937& rng) const;
+  bool isPositive(size_t a, size_t b) const { return a != b && label_[a] == label_[b]; }
+  bool isNegative(size_t a, size_t b) const {
+    return set_->observations[a].instance != set_->observations[b].instance;
+  }
+
+ private:
+  const TrainingSet* set_;
+  std::vector<size_t> subset_;
+  std::vector<int> label_;                    // per observation of the whole set
+  std::vector<std::vector<size_t>> members_;  // per label: its observations in the subset
+  std::vector<size_t> anchors_;
+};
+
+// ---- Retrieval accuracy ------------------------------------------------------------------------
+
+// The last kept observation of each segment (per source): the most complete one, which is what
+// a target map holds.
+std::vector<bool> finalObservations(const TrainingSet& set);
+
+struct RetrievalAccuracy {
+  double top1 = 0.0, top5 = 0.0;  // shares of the queries; 0 when there is no query
+  size_t queries = 0;
+};
+
+// For each query row whose label is in the database: is the nearest database row (Euclidean)
+// of its label (top-1), or one of the five nearest (top-5)? Queries without their label in the
+// database are not counted.
+RetrievalAccuracy retrievalAccuracy(const Eigen::MatrixXf& queries,
+                                    const std::vector<int>& query_labels,
+                                    const Eigen::MatrixXf& database,
+                                    const std::vector<int>& database_labels);
+
+}  // namespace semsegmap

@@ -1,0 +1,439 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "semsegmap/learn/augment.h"
+#include "semsegmap/learn/trainer.h"
+#include "semsegmap/learn/training_data.h"
+#include "semsegmap/sim/world.h"
+
+using namespace semsegmap;
+
+namespace {
+
+EnrichedCloud randomCloud(size_t n, uint32_t seed, ClassId class_id = cls::kBuilding) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  EnrichedCloud cloud(n);
+  for (auto& p : cloud) {
+    p.x = 10.0f + 4.0f * u(rng), p.y = -5.0f + 2.0f * u(rng), p.z = 3.0f * u(rng);
+    p.h = u(rng), p.s = u(rng), p.v = u(rng);
+    p.has_color = true;
+    p.class_id = class_id;
+  }
+  return cloud;
+}
+
+float distance(const EnrichedPoint& p, const Eigen::Vector3f& c) {
+  return (Eigen::Vector3f(p.x, p.y, p.z) - c).norm();
+}
+
+// Observations of `instances` instances, `per_instance` each, spread over two sources.
+TrainingSet syntheticSet(int instances, int per_instance) {
+  TrainingSet set;
+  set.sources = {"a", "b"};
+  for (int i = 1; i <= instances; ++i)
+    for (int k = 0; k < per_instance; ++k) {
+      TrainingObservation o;
+      o.instance = static_cast<uint16_t>(i);
+      o.majority_class = cls::kBuilding;
+      o.source = static_cast<uint16_t>(k % 2);
+      o.segment = i * 10 + k;
+      const EnrichedCloud c = randomCloud(20, static_cast<uint32_t>(i * 100 + k));
+      for (const auto& p : c) {
+        o.xyzhsv.insert(o.xyzhsv.end(), {p.x, p.y, p.z, p.h, p.s, p.v});
+        o.classes.push_back(p.class_id);
+        o.colored.push_back(1);
+      }
+      o.n_points = 20;
+      o.purity = 1.0f;
+      set.observations.push_back(std::move(o));
+    }
+  return set;
+}
+
+}  // namespace
+
+// ---- Augmentation ------------------------------------------------------------------------------
+
+TEST(Augment, YawRotationKeepsDistancesToTheCentroid) {
+  const EnrichedCloud cloud = randomCloud(500, 1);
+  const Eigen::Vector3f c = centroidOf(cloud);
+  const EnrichedCloud turned = rotateYaw(cloud, 0.9);
+  ASSERT_EQ(turned.size(), cloud.size());
+  EXPECT_LT((centroidOf(turned) - c).norm(), 1e-4f);
+  double moved = 0.0;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    EXPECT_NEAR(distance(turned[i], c), distance(cloud[i], c), 1e-4f);
+    EXPECT_FLOAT_EQ(turned[i].z, cloud[i].z);
+    moved += std::hypot(turned[i].x - cloud[i].x, turned[i].y - cloud[i].y);
+  }
+  EXPECT_GT(moved / cloud.size(), 0.3) << "a 0.9 rad turn must move the points";
+}
+
+TEST(Augment, ScaleIsAboutTheCentroid) {
+  const EnrichedCloud cloud = randomCloud(200, 2);
+  const Eigen::Vector3f c = centroidOf(cloud);
+  const EnrichedCloud scaled = scaleAboutCentroid(cloud, 1.1);
+  EXPECT_LT((centroidOf(scaled) - c).norm(), 1e-4f);
+  for (size_t i = 0; i < cloud.size(); ++i)
+    EXPECT_NEAR(distance(scaled[i], c), 1.1f * distance(cloud[i], c), 1e-4f);
+}
+
+TEST(Augment, JitterMovesPointsBySigma) {
+  const EnrichedCloud cloud = randomCloud(5000, 3);
+  std::mt19937 rng(3);
+  const EnrichedCloud noisy = jitterPoints(cloud, 0.02, rng);
+  double sq = 0.0;
+  for (size_t i = 0; i < cloud.size(); ++i) sq += std::pow(noisy[i].x - cloud[i].x, 2);
+  EXPECT_NEAR(std::sqrt(sq / cloud.size()), 0.02, 0.002);
+}
+
+TEST(Augment, DropRemovesAboutTheRequestedFraction) {
+  const EnrichedCloud cloud = randomCloud(10000, 4);
+  std::mt19937 rng(4);
+  EXPECT_NEAR(static_cast<double>(dropPoints(cloud, 0.3, rng).size()), 7000.0, 300.0);
+  EXPECT_EQ(dropPoints(cloud, 0.0, rng).size(), cloud.size());
+  EXPECT_EQ(dropPoints(cloud, 1.0, rng).size(), 1u) << "one point always survives";
+}
+
+TEST(Augment, SectionCutRemovesOneSideOfAPlane) {
+  const EnrichedCloud cloud = randomCloud(4000, 5);
+  const Eigen::Vector3f c = centroidOf(cloud);
+  const Eigen::Vector3f n = Eigen::Vector3f(1, 1, 0).normalized();
+  const EnrichedCloud cut = cutByPlane(cloud, n, 0.5);
+  size_t beyond = 0;
+  for (const auto& p : cloud) beyond += n.dot(Eigen::Vector3f(p.x, p.y, p.z) - c) > 0.5f;
+  ASSERT_GT(beyond, 100u);
+  EXPECT_EQ(cut.size(), cloud.size() - beyond);
+  for (const auto& p : cut) EXPECT_LE(n.dot(Eigen::Vector3f(p.x, p.y, p.z) - c), 0.5f);
+
+  // A random plane placed to cut a given share.
+  std::mt19937 rng(5);
+  const EnrichedCloud section = cutSection(cloud, 0.25, rng);
+  EXPECT_NEAR(static_cast<double>(section.size()), 3000.0, 5.0);
+}
+
+TEST(Augment, WrongLabelsChangeAboutTheRequestedFraction) {
+  const EnrichedCloud cloud = randomCloud(10000, 6, cls::kVegetation);
+  std::mt19937 rng(6);
+  const EnrichedCloud relabeled = relabelPoints(cloud, 0.2, 15, rng);
+  size_t changed = 0;
+  for (const auto& p : relabeled) {
+    changed += p.class_id != cls::kVegetation;
+    EXPECT_GE(p.class_id, 1);
+    EXPECT_LE(p.class_id, 14);
+  }
+  EXPECT_NEAR(static_cast<double>(changed), 2000.0, 200.0);
+}
+
+TEST(Augment, ColourShiftMovesHueCyclically) {
+  EnrichedCloud cloud(3);
+  cloud[0].h = 0.95f, cloud[0].s = 0.5f, cloud[0].v = 0.9f, cloud[0].has_color = true;
+  cloud[1].h = 0.02f, cloud[1].s = 0.5f, cloud[1].v = 0.5f, cloud[1].has_color = true;
+  cloud[2].h = 0.3f, cloud[2].s = 0.5f, cloud[2].v = 0.5f, cloud[2].has_color = false;
+  const EnrichedCloud up = shiftColor(cloud, 0.1, 1.2, 1.2);
+  EXPECT_NEAR(up[0].h, 0.05f, 1e-5f) << "0.95 + 0.1 wraps to 0.05";
+  EXPECT_NEAR(up[0].s, 0.6f, 1e-5f);
+  EXPECT_FLOAT_EQ(up[0].v, 1.0f) << "value is clamped to 1";
+  EXPECT_FLOAT_EQ(up[2].h, 0.3f) << "a point without colour keeps its (meaningless) colour";
+  const EnrichedCloud down = shiftColor(cloud, -0.05, 1.0, 1.0);
+  EXPECT_NEAR(down[1].h, 0.97f, 1e-5f) << "0.02 - 0.05 wraps to 0.97";
+  for (const auto& p : shiftColor(cloud, 3.7, 1.0, 1.0)) {
+    EXPECT_GE(p.h, 0.0f);
+    EXPECT_LT(p.h, 1.0f);
+  }
+}
+
+TEST(Augment, AugmentIsPureAndKeepsPoints) {
+  const EnrichedCloud cloud = randomCloud(1000, 7);
+  const EnrichedCloud copy = cloud;
+  std::mt19937 a(7), b(7);
+  const EnrichedCloud x = augment(cloud, AugmentConfig{}, a);
+  const EnrichedCloud y = augment(cloud, AugmentConfig{}, b);
+  EXPECT_GE(x.size(), 500u);  // at most 30 % cut, then at most 20 % dropped
+  EXPECT_LT(x.size(), cloud.size() + 1);
+  ASSERT_EQ(x.size(), y.size()) << "same seed, same augmentation";
+  for (size_t i = 0; i < x.size(); ++i) EXPECT_EQ(x[i].x, y[i].x);
+  for (size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(cloud[i].x, copy[i].x);
+}
+
+// ---- Pairs, split, retrieval -------------------------------------------------------------------
+
+TEST(TrainingData, PositivesShareALandmarkNegativesDoNot) {
+  TrainingSet set = syntheticSet(30, 3);
+  // Instance 1 is a tree: trunk and crown are one instance but two landmarks.
+  set.observations[0].majority_class = cls::kTrunk;
+  std::vector<size_t> all(set.observations.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  const PairSampler sampler(set, all);
+  EXPECT_EQ(sampler.anchors().size(), set.observations.size() - 1) << "the lone trunk";
+  EXPECT_FALSE(sampler.hasPositive(0));
+  std::mt19937 rng(1);
+  std::set<size_t> positives_seen;
+  for (size_t a : sampler.anchors())
+    for (int k = 0; k < 20; ++k) {
+      const size_t p = sampler.positive(a, rng), n = sampler.negative(a, rng);
+      ASSERT_NE(p, a);
+      EXPECT_EQ(set.observations[p].instance, set.observations[a].instance);
+      EXPECT_EQ(set.observations[p].majority_class, set.observations[a].majority_class);
+      EXPECT_NE(set.observations[n].instance, set.observations[a].instance);
+      if (a == 4) positives_seen.insert(p);
+    }
+  EXPECT_EQ(positives_seen, (std::set<size_t>{3, 5})) << "every other observation is drawn";
+}
+
+TEST(TrainingData, ValidationSplitIsByInstance) {
+  const TrainingSet set = syntheticSet(400, 3);
+  const TrainValSplit split = splitByInstance(set, 0.1, 1);
+  EXPECT_EQ(split.train.size() + split.validation.size(), set.observations.size());
+  std::set<uint16_t> train, val;
+  for (size_t i : split.train) train.insert(set.observations[i].instance);
+  for (size_t i : split.validation) val.insert(set.observations[i].instance);
+  for (uint16_t i : val) EXPECT_EQ(train.count(i), 0u) << "instance " << i << " in both halves";
+  EXPECT_NEAR(static_cast<double>(val.size()), 40.0, 15.0);
+  // The same instance lands in the same half whatever the set.
+  for (uint16_t i : val) EXPECT_TRUE(isValidationInstance(i, 0.1, 1));
+  const TrainValSplit again = splitByInstance(set, 0.1, 1);
+  EXPECT_EQ(again.validation, split.validation);
+}
+
+TEST(TrainingData, RetrievalAccuracyOfHandMadeDescriptors) {
+  // One dimension. Database: landmark 0 at 0.0, landmark 1 at 1.0, landmark 2 at 0.12.
+  // Queries: 0.05 (0) -> 0.0 hit; 0.1 (0) -> 0.12 miss, but 0.0 is second; 0.9 (1) -> 1.0 hit;
+  // 0.5 (landmark 3, not in the database) is no query.
+  Eigen::MatrixXf db(3, 1), q(4, 1);
+  db << 0.0f, 1.0f, 0.12f;
+  q << 0.05f, 0.1f, 0.9f, 0.5f;
+  const RetrievalAccuracy acc = retrievalAccuracy(q, {0, 0, 1, 3}, db, {0, 1, 2});
+  EXPECT_EQ(acc.queries, 3u);
+  EXPECT_DOUBLE_EQ(acc.top1, 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(acc.top5, 1.0);
+  // Top-5 fails with five distractors nearer than the match.
+  Eigen::MatrixXf far(6, 1), one(1, 1);
+  far << 0.01f, 0.02f, 0.03f, 0.04f, 0.05f, 1.0f;
+  one << 0.0f;
+  const RetrievalAccuracy none = retrievalAccuracy(one, {9}, far, {1, 2, 3, 4, 5, 9});
+  EXPECT_EQ(none.queries, 1u);
+  EXPECT_DOUBLE_EQ(none.top5, 0.0);
+  EXPECT_THROW(retrievalAccuracy(q, {0}, db, {0, 1, 2}), std::invalid_argument);
+}
+
+TEST(TrainingData, FinalObservationIsTheLastOfEachSegment) {
+  TrainingSet set = syntheticSet(2, 3);  // segments 10, 11, 12, 20, 21, 22: one obs each
+  set.observations[1].segment = 10;      // segment 10 now has observations 0 and 1
+  set.observations[1].source = set.observations[0].source;
+  const std::vector<bool> final = finalObservations(set);
+  EXPECT_EQ(final, (std::vector<bool>{false, true, true, true, true, true}));
+}
+
+TEST(TrainingData, DatasetListSplitsAroundSimSpecs) {
+  using V = std::vector<std::string>;
+  EXPECT_EQ(splitDatasetSpecs("sim:world=1,run=S1,sim:world=1,run=S1,condition=sunrise"),
+            (V{"sim:world=1,run=S1", "sim:world=1,run=S1,condition=sunrise"}));
+  EXPECT_EQ(splitDatasetSpecs("data/s1,sim:run=S2,frames=5,/abs/dir,dir2"),
+            (V{"data/s1", "sim:run=S2,frames=5", "/abs/dir", "dir2"}));
+  EXPECT_EQ(splitDatasetSpecs("sim:run=S1;sim:run=S2"), (V{"sim:run=S1", "sim:run=S2"}));
+  EXPECT_EQ(splitDatasetSpecs("sim:"), (V{"sim:"}));
+  EXPECT_THROW(splitDatasetSpecs(""), std::invalid_argument);
+  EXPECT_THROW(splitDatasetSpecs("sim:run=S1,,dir"), std::invalid_argument);
+}
+
+TEST(TrainingData, CacheRoundTripsAndKnowsWhatItWasMadeFrom) {
+  const TrainingSet set = syntheticSet(5, 2);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("test_learn_cache_" +
+                     std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + ".bin");
+  writeTrainingCache(path, set, "made from A");
+  const auto back = readTrainingCache(path, "made from A");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->sources, set.sources);
+  ASSERT_EQ(back->observations.size(), set.observations.size());
+  for (size_t i = 0; i < set.observations.size(); ++i) {
+    const auto &x = set.observations[i], &y = back->observations[i];
+    EXPECT_EQ(x.instance, y.instance);
+    EXPECT_EQ(x.segment, y.segment);
+    EXPECT_EQ(x.source, y.source);
+    EXPECT_EQ(x.xyzhsv, y.xyzhsv);
+    EXPECT_EQ(x.classes, y.classes);
+    EXPECT_EQ(x.colored, y.colored);
+  }
+  EXPECT_FALSE(readTrainingCache(path, "made from B").has_value());
+  EXPECT_FALSE(readTrainingCache(path.string() + ".missing", "made from A").has_value());
+  // Truncated and corrupted files are errors, not silently empty data.
+  const auto size = std::filesystem::file_size(path);
+  std::filesystem::resize_file(path, size - 10);
+  EXPECT_THROW(readTrainingCache(path, "made from A"), std::runtime_error);
+  writeTrainingCache(path, set, "made from A");
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(size / 2));
+    f.put('\x5a');
+  }
+  EXPECT_THROW(readTrainingCache(path, "made from A"), std::runtime_error);
+  std::filesystem::remove(path);
+}
+
+// ---- Extraction from the simulator and training ------------------------------------------------
+
+class SimulatedData : public ::testing::Test {
+ protected:
+  // One extraction for every test below: the simulator is the slow part.
+  static void SetUpTestSuite() {
+    ExtractionConfig config;
+    config.max_points_per_observation = 1024;
+    data_ = new TrainingSet(
+        extractTrainingSet({"sim:world=1,run=S2,preset=tiny,frames=20",
+                            "sim:world=1,run=S2,preset=tiny,frames=20,condition=sunrise"},
+                           PipelineConfig{}, config));
+  }
+  static void TearDownTestSuite() {
+    delete data_;
+    data_ = nullptr;
+  }
+  // Small networks, so that a few steps take a second.
+  static TrainConfig tinyTraining() {
+    TrainConfig c;
+    c.net.num_points = 64;
+    c.net.pointnet_width = 8;
+    c.net.recon_grid = 8;
+    c.net.grid_xy = 16;
+    c.net.grid_z = 8;
+    c.net.cnn_width = 8;
+    c.epochs = 3;
+    c.batch_size = 8;
+    c.anchors_per_epoch = 64;
+    c.warmup_epochs = 1;
+    c.validation_fraction = 0.2;
+    // One thread: OpenMP's spinning threads crawl when the machine is shared (ctest -j).
+    c.threads = 1;
+    return c;
+  }
+  static TrainingSet* data_;
+};
+TrainingSet* SimulatedData::data_ = nullptr;
+
+TEST_F(SimulatedData, ExtractionGivesObservationsWithPointsAndInstances) {
+  const TrainingSet& set = *data_;
+  ASSERT_GT(set.observations.size(), 40u);
+  EXPECT_EQ(ExtractionConfig{}.first_transient_instance, sim::kTrafficInstanceBase);
+  std::map<uint16_t, std::set<uint16_t>> sources_of;
+  std::map<uint16_t, int> count;
+  for (const auto& o : set.observations) {
+    EXPECT_NE(o.instance, 0);
+    EXPECT_LT(o.instance, sim::kTrafficInstanceBase) << "parked cars are no landmarks";
+    EXPECT_GT(o.purity, 0.8f);
+    EXPECT_GE(o.n_points, o.size());
+    EXPECT_GT(o.size(), 0u);
+    EXPECT_LE(o.size(), 1024u);
+    EXPECT_EQ(o.xyzhsv.size(), 6 * o.size());
+    // The stored points are the segment's: their centroid is the observation's when none
+    // were subsampled away.
+    if (o.size() == o.n_points) {
+      EXPECT_LT((centroidOf(o.cloud()) - o.centroid).norm(), 1e-2f);
+    }
+    sources_of[o.instance].insert(o.source);
+    ++count[o.instance];
+  }
+  int observed_often = 0, in_both_runs = 0;
+  for (const auto& [instance, n] : count) observed_often += n >= 3;
+  for (const auto& [instance, s] : sources_of) in_both_runs += s.size() == 2;
+  EXPECT_GE(observed_often, 5) << "segments are observed several times as they grow";
+  EXPECT_GE(in_both_runs, 5) << "instance ids are the same in both conditions";
+}
+
+TEST_F(SimulatedData, AFewStepsTrainReduceTheLossAndWriteAModel) {
+  const auto out = std::filesystem::temp_directory_path() /
+                   ("test_learn_model_" +
+                    std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + ".pt");
+  for (DescriptorKind kind : {DescriptorKind::kSemSegMapNet, DescriptorKind::kSegMapCnn}) {
+    TrainConfig config = tinyTraining();
+    config.net.kind = kind;
+    config.epochs = 6;
+    // Plain training: no augmentation and no mining, so that the batch loss is comparable across
+    // epochs, and no validation, so that the best epoch is the one of lowest training loss.
+    config.augment = false;
+    config.warmup_epochs = config.epochs;
+    config.validation_fraction = 0.0;
+    // Fixed training triplets, to measure the loss on the same thing before and after.
+    const TrainValSplit split = splitByInstance(*data_, config.validation_fraction, 1);
+    const PairSampler sampler(*data_, split.train);
+    std::mt19937 rng(9);
+    std::vector<Triplet> fixed;
+    for (size_t k = 0; k < 32; ++k) {
+      const size_t a = sampler.anchors()[k * 7 % sampler.anchors().size()];
+      fixed.push_back({a, sampler.positive(a, rng), sampler.negative(a, rng)});
+    }
+    torch::manual_seed(config.seed);  // the initial weights trainDescriptor starts from
+    const double before = evaluateTriplets(*makeNet(config.net), *data_, fixed, config);
+
+    int epochs_seen = 0;
+    TrainCallbacks callbacks;
+    callbacks.epoch = [&](const EpochStats&) { ++epochs_seen; };
+    const TrainResult result = trainDescriptor(*data_, config, out, callbacks);
+    ASSERT_EQ(result.history.size(), 6u);
+    EXPECT_EQ(epochs_seen, 6);
+    EXPECT_GT(result.anchors, 0u);
+    EXPECT_EQ(result.validation_observations, 0u);
+    for (const auto& e : result.history) EXPECT_TRUE(std::isfinite(e.loss));
+    const double after = evaluateTriplets(*result.net, *data_, fixed, config);
+    EXPECT_LT(after, 0.8 * before) << descriptorName(kind);
+    EXPECT_LT(result.history.back().loss, result.history.front().loss) << descriptorName(kind);
+    ASSERT_GE(result.best_epoch, 1);
+    EXPECT_TRUE(result.history[result.best_epoch - 1].best);
+
+    // The file holds the best epoch, which is also what the result carries.
+    const auto loaded = loadNet(out, kind);
+    EXPECT_EQ(netFingerprint(*loaded), netFingerprint(*result.net));
+    const std::vector<size_t> some = {0, 1, 2};
+    const Eigen::MatrixXf x = describeObservations(*loaded, *data_, some, 3);
+    const Eigen::MatrixXf y = describeObservations(*result.net, *data_, some, 3);
+    EXPECT_LT((x - y).cwiseAbs().maxCoeff(), 1e-5f);
+  }
+  std::filesystem::remove(out);
+}
+
+// With augmentation, hard negatives from epoch 2 and validation: the full recipe, twice.
+TEST_F(SimulatedData, TrainingIsDeterministicForASeedAndKeepsTheBestEpoch) {
+  const TrainConfig config = tinyTraining();
+  const TrainResult a = trainDescriptor(*data_, config);
+  const TrainResult b = trainDescriptor(*data_, config);
+  ASSERT_EQ(a.history.size(), b.history.size());
+  for (size_t i = 0; i < a.history.size(); ++i) {
+    EXPECT_EQ(a.history[i].loss, b.history[i].loss);
+    EXPECT_EQ(a.history[i].validation.top1, b.history[i].validation.top1);
+  }
+  EXPECT_EQ(netFingerprint(*a.net), netFingerprint(*b.net));
+
+  EXPECT_GT(a.validation_observations, 0u);
+  double best_top1 = -1.0;
+  for (const auto& e : a.history) {
+    EXPECT_GT(e.validation.queries, 0u);
+    EXPECT_GE(e.validation.top5, e.validation.top1);
+    best_top1 = std::max(best_top1, e.validation.top1);
+  }
+  ASSERT_GE(a.best_epoch, 1);
+  EXPECT_EQ(a.history[a.best_epoch - 1].validation.top1, best_top1);
+  // The returned weights are the best epoch's: they reproduce its validation accuracy.
+  const TrainValSplit split = splitByInstance(*data_, config.validation_fraction, 1);
+  const RetrievalAccuracy again = validationAccuracy(*a.net, *data_, split.validation, config.seed,
+                                                     config.max_validation_queries);
+  EXPECT_EQ(again.top1, best_top1);
+}
+
+TEST(Trainer, RejectsBadConfigurations) {
+  const TrainingSet set = syntheticSet(4, 2);
+  TrainConfig config;
+  config.net.kind = DescriptorKind::kEigen;
+  EXPECT_THROW(trainDescriptor(set, config), std::invalid_argument);
+  config.net.kind = DescriptorKind::kSemSegMapNet;
+  config.batch_size = 0;
+  EXPECT_THROW(trainDescriptor(set, config), std::invalid_argument);
+  // Every instance seen once: nothing to learn from.
+  config.batch_size = 4;
+  EXPECT_THROW(trainDescriptor(syntheticSet(4, 1), config), std::runtime_error);
+}
