@@ -36,6 +36,7 @@ float distance(const EnrichedPoint& p, const Eigen::Vector3f& c) {
 TrainingSet syntheticSet(int instances, int per_instance) {
   TrainingSet set;
   set.sources = {"a", "b"};
+  set.source_worlds = {"w", "w"};  // two runs through one world
   for (int i = 1; i <= instances; ++i)
     for (int k = 0; k < per_instance; ++k) {
       TrainingObservation o;
@@ -196,10 +197,33 @@ TEST(TrainingData, ValidationSplitIsByInstance) {
   for (size_t i : split.validation) val.insert(set.observations[i].instance);
   for (uint16_t i : val) EXPECT_EQ(train.count(i), 0u) << "instance " << i << " in both halves";
   EXPECT_NEAR(static_cast<double>(val.size()), 40.0, 15.0);
-  // The same instance lands in the same half whatever the set.
-  for (uint16_t i : val) EXPECT_TRUE(isValidationInstance(i, 0.1, 1));
-  const TrainValSplit again = splitByInstance(set, 0.1, 1);
-  EXPECT_EQ(again.validation, split.validation);
+  // The same object lands in the same half whatever the set.
+  const std::vector<uint64_t> keys = objectKeys(set);
+  for (size_t i : split.validation) EXPECT_TRUE(isValidationObject(keys[i], 0.1, 1));
+  TrainingSet fewer = set;
+  fewer.observations.resize(300);
+  const TrainValSplit part = splitByInstance(fewer, 0.1, 1);
+  for (size_t i : part.validation) EXPECT_TRUE(isValidationObject(keys[i], 0.1, 1));
+}
+
+TEST(TrainingData, InstanceIdsAreOnlyComparableWithinAWorld) {
+  EXPECT_EQ(worldOf("sim:run=S1,condition=sunrise,frames=9"), "sim:world=1,preset=full");
+  EXPECT_EQ(worldOf("sim:world=3,run=S2,preset=tiny"), "sim:world=3,preset=tiny");
+  EXPECT_EQ(worldOf("data/run1"), "data/run1");
+  TrainingSet set = syntheticSet(3, 2);  // instances 1..3, observed in sources 0 and 1
+  set.sources.push_back("c");
+  set.source_worlds.push_back("another world");
+  TrainingObservation stranger = set.observations[0];  // instance 1, but of another world
+  stranger.source = 2;
+  set.observations.push_back(stranger);
+  std::vector<size_t> all(set.observations.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  const PairSampler sampler(set, all);
+  EXPECT_TRUE(sampler.isPositive(0, 1)) << "instance 1 in two runs of world w";
+  EXPECT_FALSE(sampler.isPositive(0, 6)) << "instance 1 of another world is another object";
+  EXPECT_TRUE(sampler.isNegative(0, 6));
+  EXPECT_FALSE(sampler.hasPositive(6));
+  EXPECT_NE(objectKeys(set)[0], objectKeys(set)[6]);
 }
 
 TEST(TrainingData, RetrievalAccuracyOfHandMadeDescriptors) {
@@ -252,6 +276,7 @@ TEST(TrainingData, CacheRoundTripsAndKnowsWhatItWasMadeFrom) {
   const auto back = readTrainingCache(path, "made from A");
   ASSERT_TRUE(back.has_value());
   EXPECT_EQ(back->sources, set.sources);
+  EXPECT_EQ(back->source_worlds, set.source_worlds);
   ASSERT_EQ(back->observations.size(), set.observations.size());
   for (size_t i = 0; i < set.observations.size(); ++i) {
     const auto &x = set.observations[i], &y = back->observations[i];
@@ -321,6 +346,8 @@ TEST_F(SimulatedData, ExtractionGivesObservationsWithPointsAndInstances) {
   const TrainingSet& set = *data_;
   ASSERT_GT(set.observations.size(), 40u);
   EXPECT_EQ(ExtractionConfig{}.first_transient_instance, sim::kTrafficInstanceBase);
+  ASSERT_EQ(set.source_worlds.size(), 2u);
+  EXPECT_EQ(set.source_worlds[0], set.source_worlds[1]) << "one world, two conditions";
   std::map<uint16_t, std::set<uint16_t>> sources_of;
   std::map<uint16_t, int> count;
   for (const auto& o : set.observations) {

@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "semsegmap/core/random.h"
@@ -108,11 +109,27 @@ TrainingSet extractTrainingSet(const std::vector<std::string>& specs,
   if (specs.size() > 0xffff) throw std::invalid_argument("too many datasets (at most 65535)");
   TrainingSet set;
   set.sources = specs;
+  for (const auto& spec : specs) set.source_worlds.push_back(worldOf(spec));
   for (size_t i = 0; i < specs.size(); ++i) {
     auto source = openDataset(specs[i]);
     appendObservations(*source, static_cast<uint16_t>(i), pipeline, config, set, progress);
   }
   return set;
+}
+
+std::string worldOf(const std::string& spec) {
+  if (spec.rfind("sim:", 0) != 0) return spec;
+  // The defaults of openDataset: world 1, the full preset.
+  std::string world = "1", preset = "full";
+  std::stringstream ss(spec.substr(4));
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos) continue;
+    if (item.substr(0, eq) == "world") world = item.substr(eq + 1);
+    if (item.substr(0, eq) == "preset") preset = item.substr(eq + 1);
+  }
+  return "sim:world=" + world + ",preset=" + preset;
 }
 
 std::vector<std::string> splitDatasetSpecs(const std::string& list) {
@@ -150,13 +167,14 @@ std::vector<std::string> splitDatasetSpecs(const std::string& list) {
 namespace {
 
 // Layout (host byte order, little-endian on every platform we build for):
-//   "SSMTRAIN" u32 version | str provenance | u32 n, n x str source | u64 n, n x observation |
+//   "SSMTRAIN" u32 version | str provenance | u32 n, n x (str source, str world) |
+//   u64 n, n x observation |
 //   u64 FNV-1a of every byte after the version
 // str = u32 length + bytes; observation = u16 instance, u16 class, u16 source, i64 segment,
 //   u32 n_points, f32 purity, 3 x f32 centroid, u32 count, count x 6 f32, count x u16 class,
 //   count x u8 colored.
 constexpr char kCacheMagic[8] = {'S', 'S', 'M', 'T', 'R', 'A', 'I', 'N'};
-constexpr uint32_t kCacheVersion = 1;
+constexpr uint32_t kCacheVersion = 2;
 
 struct Fnv {
   uint64_t h = 1469598103934665603ULL;
@@ -251,7 +269,10 @@ void writeTrainingCache(const std::filesystem::path& path, const TrainingSet& se
     Writer w(out);
     w.str(provenance);
     w.value(static_cast<uint32_t>(set.sources.size()));
-    for (const auto& s : set.sources) w.str(s);
+    for (size_t i = 0; i < set.sources.size(); ++i) {
+      w.str(set.sources[i]);
+      w.str(i < set.source_worlds.size() ? set.source_worlds[i] : set.sources[i]);
+    }
     w.value(static_cast<uint64_t>(set.observations.size()));
     for (const TrainingObservation& o : set.observations) {
       w.value(o.instance);
@@ -286,8 +307,13 @@ std::optional<TrainingSet> readTrainingCache(const std::filesystem::path& path,
   Reader r(in, path);
   if (r.str() != provenance) return std::nullopt;
   TrainingSet set;
-  set.sources.resize(r.value<uint32_t>());
-  for (auto& s : set.sources) s = r.str();
+  const uint32_t n_sources = r.value<uint32_t>();
+  if (n_sources > r.remaining() / 8)
+    throw std::runtime_error(path.string() + ": corrupt training cache (bad source count)");
+  for (uint32_t i = 0; i < n_sources; ++i) {
+    set.sources.push_back(r.str());
+    set.source_worlds.push_back(r.str());
+  }
   set.observations.resize(r.count(38));  // 38: the fixed part of an observation
   for (TrainingObservation& o : set.observations) {
     o.instance = r.value<uint16_t>();
@@ -317,34 +343,53 @@ std::optional<TrainingSet> readTrainingCache(const std::filesystem::path& path,
 
 // ---- Pairs, negatives and the validation split -------------------------------------------------
 
+std::vector<uint64_t> objectKeys(const TrainingSet& set) {
+  std::vector<uint64_t> world(set.sources.size());
+  for (size_t s = 0; s < world.size(); ++s) {
+    const std::string& name = s < set.source_worlds.size() ? set.source_worlds[s] : set.sources[s];
+    Fnv fnv;
+    fnv.add(name.data(), name.size());
+    world[s] = fnv.h;
+  }
+  std::vector<uint64_t> keys;
+  keys.reserve(set.observations.size());
+  for (const auto& o : set.observations) {
+    if (o.source >= world.size())
+      throw std::out_of_range("training data: observation of unknown source " +
+                              std::to_string(o.source));
+    keys.push_back(hashKeys(world[o.source], o.instance));
+  }
+  return keys;
+}
+
 std::vector<int> landmarkLabels(const TrainingSet& set) {
-  std::map<std::pair<uint16_t, ClassId>, int> ids;
+  const std::vector<uint64_t> objects = objectKeys(set);
+  std::map<std::pair<uint64_t, ClassId>, int> ids;
   std::vector<int> labels;
   labels.reserve(set.observations.size());
-  for (const auto& o : set.observations) {
-    auto it =
-        ids.emplace(std::make_pair(o.instance, o.majority_class), static_cast<int>(ids.size()));
+  for (size_t i = 0; i < objects.size(); ++i) {
+    auto it = ids.emplace(std::make_pair(objects[i], set.observations[i].majority_class),
+                          static_cast<int>(ids.size()));
     labels.push_back(it.first->second);
   }
   return labels;
 }
 
-bool isValidationInstance(uint16_t instance, double validation_fraction, uint64_t seed) {
-  return uniformFromHash(hashKeys(seed, instance, 0x7a11da7e)) < validation_fraction;
+bool isValidationObject(uint64_t object_key, double validation_fraction, uint64_t seed) {
+  return uniformFromHash(hashKeys(seed, object_key, 0x7a11da7e)) < validation_fraction;
 }
 
 TrainValSplit splitByInstance(const TrainingSet& set, double validation_fraction, uint64_t seed) {
+  const std::vector<uint64_t> objects = objectKeys(set);
   TrainValSplit split;
-  for (size_t i = 0; i < set.observations.size(); ++i)
-    (isValidationInstance(set.observations[i].instance, validation_fraction, seed)
-         ? split.validation
-         : split.train)
+  for (size_t i = 0; i < objects.size(); ++i)
+    (isValidationObject(objects[i], validation_fraction, seed) ? split.validation : split.train)
         .push_back(i);
   return split;
 }
 
 PairSampler::PairSampler(const TrainingSet& set, std::vector<size_t> subset)
-    : set_(&set), subset_(std::move(subset)), label_(landmarkLabels(set)) {
+    : subset_(std::move(subset)), object_(objectKeys(set)), label_(landmarkLabels(set)) {
   const int n_labels = label_.empty() ? 0 : *std::max_element(label_.begin(), label_.end()) + 1;
   members_.resize(n_labels);
   for (size_t i : subset_) {
@@ -372,14 +417,14 @@ size_t PairSampler::positive(size_t anchor, std::mt19937& rng) const {
 
 size_t PairSampler::negative(size_t anchor, std::mt19937& rng) const {
   std::uniform_int_distribution<size_t> pick(0, subset_.size() - 1);
-  // Nearly every draw is of another instance; the bound only guards a degenerate set.
+  // Nearly every draw is of another object; the bound only guards a degenerate set.
   for (int attempt = 0; attempt < 1000; ++attempt) {
     const size_t j = subset_[pick(rng)];
     if (isNegative(anchor, j)) return j;
   }
   for (size_t j : subset_)
     if (isNegative(anchor, j)) return j;
-  throw std::runtime_error("training data has a single instance: no negative to learn from");
+  throw std::runtime_error("training data has a single object: no negative to learn from");
 }
 
 // ---- Retrieval accuracy ------------------------------------------------------------------------

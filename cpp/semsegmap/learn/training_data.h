@@ -1,7 +1,7 @@
 // Training data of the learned descriptors (paper section IV: trained only on simulated ground
 // truth): every observation of every segment, with the ground-truth instance its points belong
-// to, extracted by running the pipeline with ground-truth poses. Observations of one instance,
-// from any run or lighting condition, are positives of each other.
+// to, extracted by running the pipeline with ground-truth poses. Observations of one landmark
+// (instance and class), from any run or lighting condition, are positives of each other.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +23,7 @@ namespace semsegmap {
 // One segment observation, stored compactly: 27 bytes a point instead of sizeof(EnrichedPoint).
 struct TrainingObservation {
   uint16_t instance = 0;                               // majority ground-truth instance
-  ClassId majority_class = cls::kUnknown;              //
+  ClassId majority_class = cls::kUnknown;              // of the segment's voxels
   uint16_t source = 0;                                 // index into TrainingSet::sources
   int64_t segment = 0;                                 // segment id within that source's run
   uint32_t n_points = 0;                               // before subsampling (the loss's sigma)
@@ -39,8 +39,16 @@ struct TrainingObservation {
 
 struct TrainingSet {
   std::vector<std::string> sources;  // dataset specs
+  // Per source, the world its instance ids belong to (worldOf): runs through one world share
+  // ids, so that their observations of an instance are positives; another world's ids are
+  // unrelated objects. A missing entry means the source's own world.
+  std::vector<std::string> source_worlds;
   std::vector<TrainingObservation> observations;
 };
+
+// "sim:world=N,preset=P" for a sim spec, whatever its run, condition, traffic or frames; the spec
+// itself for anything else (a dataset directory is a world of its own).
+std::string worldOf(const std::string& spec);
 
 struct ExtractionConfig {
   float min_purity = 0.8f;  // observations at or below this purity are ambiguous labels
@@ -87,22 +95,26 @@ std::optional<TrainingSet> readTrainingCache(const std::filesystem::path& path,
 
 // ---- Pairs, negatives and the validation split -------------------------------------------------
 
-// What a descriptor must find again: the observations of one instance of one majority class (a
+// The object an observation sees: a hash of its world and instance, one per observation.
+std::vector<uint64_t> objectKeys(const TrainingSet& set);
+
+// What a descriptor must find again: the observations of one object of one majority class (a
 // tree's trunk and crown are one instance but two segments, never matched to each other).
 // Dense labels 0..L-1, one per observation.
 std::vector<int> landmarkLabels(const TrainingSet& set);
 
-// Validation instances are chosen by a hash of the instance id, never by observation, so that
-// no object is seen in training and validation; the same instance goes to the same half
-// whatever the data set.
-bool isValidationInstance(uint16_t instance, double validation_fraction, uint64_t seed);
+// Validation objects are chosen by a hash of the object key, never by observation, so that no
+// object is seen in training and validation; an object goes to the same half whatever the data
+// set it is in.
+bool isValidationObject(uint64_t object_key, double validation_fraction, uint64_t seed);
 
 struct TrainValSplit {
   std::vector<size_t> train, validation;  // indices into TrainingSet::observations
 };
 TrainValSplit splitByInstance(const TrainingSet& set, double validation_fraction, uint64_t seed);
 
-// Positives and negatives among a subset of the observations (one half of the split).
+// Positives (same landmark) and negatives (another object) among a subset of the observations
+// (one half of the split).
 class PairSampler {
  public:
   PairSampler(const TrainingSet& set, std::vector<size_t> subset);
@@ -112,16 +124,14 @@ class PairSampler {
   // Another observation of the same landmark (requires hasPositive).
   size_t positive(size_t anchor, std::mt19937& rng) const;
   bool hasPositive(size_t anchor) const;
-  // An observation of another instance, uniformly.
+  // An observation of another object, uniformly.
   size_t negative(size_t anchor, std::mt19937& rng) const;
   bool isPositive(size_t a, size_t b) const { return a != b && label_[a] == label_[b]; }
-  bool isNegative(size_t a, size_t b) const {
-    return set_->observations[a].instance != set_->observations[b].instance;
-  }
+  bool isNegative(size_t a, size_t b) const { return object_[a] != object_[b]; }
 
  private:
-  const TrainingSet* set_;
   std::vector<size_t> subset_;
+  std::vector<uint64_t> object_;              // per observation of the whole set
   std::vector<int> label_;                    // per observation of the whole set
   std::vector<std::vector<size_t>> members_;  // per label: its observations in the subset
   std::vector<size_t> anchors_;
