@@ -7,7 +7,8 @@ packages=(
   build-essential cmake pkg-config clang-format
   libeigen3-dev libembree-dev libtbb-dev libyaml-cpp-dev libopencv-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libtorch-dev libpcl-dev libqhull-dev
+  libtorch-dev libpcl-dev libqhull-dev libfaiss-dev libceres-dev
+  libopenblas0-openmp
   gnuplot-nox
 )
 

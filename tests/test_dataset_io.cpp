@@ -18,32 +18,13 @@
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/image_io.h"
+#include "temp_dir.h"
 
 namespace semsegmap {
 namespace {
 namespace fs = std::filesystem;
 
-// A fresh directory per test, removed afterwards, so tests can run in parallel under ctest.
-class TempDir {
- public:
-  TempDir() {
-    static int counter = 0;
-    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ =
-        fs::temp_directory_path() / ("semsegmap_io_" + std::string(test->name()) + "_" +
-                                     std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using semsegmap::test_support::TempDir;
 
 std::string readText(const fs::path& path) {
   return readFileBytes(path);

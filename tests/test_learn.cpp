@@ -447,8 +447,9 @@ TEST_F(SimulatedData, TrainingIsDeterministicForASeedAndKeepsTheBestEpoch) {
   EXPECT_EQ(a.history[a.best_epoch - 1].validation.top1, best_top1);
   // The returned weights are the best epoch's: they reproduce its validation accuracy.
   const TrainValSplit split = splitByInstance(*data_, config.validation_fraction, 1);
-  const RetrievalAccuracy again = validationAccuracy(*a.net, *data_, split.validation, config.seed,
-                                                     config.max_validation_queries);
+  const RetrievalAccuracy again =
+      validationAccuracy(*a.net, *data_, split.validation, config.seed,
+                         config.max_validation_queries, config.validation_min_completeness);
   EXPECT_EQ(again.top1, best_top1);
 }
 

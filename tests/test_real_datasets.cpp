@@ -20,6 +20,7 @@
 #include "semsegmap/io/kitti_raw_reader.h"
 #include "semsegmap/io/nclt_reader.h"
 #include "semsegmap/io/semantic_kitti_reader.h"
+#include "temp_dir.h"
 
 namespace semsegmap {
 namespace {
@@ -30,25 +31,7 @@ const fs::path kDay =
     fs::path(SEMSEGMAP_SHARED_DATA) / "kitti_raw_2011_09_26_sample" / "2011_09_26";
 const fs::path kDrive = kDay / "sample_sync";
 
-// A scratch folder per test, removed afterwards; the shared data is only ever read.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("semsegmap_real_datasets_" + std::to_string(getpid()) +
-                                         "_" + info->test_suite_name() + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using semsegmap::test_support::TempDir;
 
 std::string errorOf(const std::function<void()>& f) {
   try {

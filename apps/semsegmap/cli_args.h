@@ -31,6 +31,9 @@ int runDemo(const std::vector<std::string>& args);
 int runEnrich(const std::vector<std::string>& args);
 int runConvert(const std::vector<std::string>& args);
 int runSegment(const std::vector<std::string>& args);
+int runMap(const std::vector<std::string>& args);
+int runLocalize(const std::vector<std::string>& args);
+int runSlam(const std::vector<std::string>& args);
 int runTrain(const std::vector<std::string>& args);
 int runEval(const std::vector<std::string>& args);
 

@@ -10,6 +10,7 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "semsegmap/io/atomic_file.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/learn/trainer.h"
 
@@ -134,15 +135,26 @@ class EpochProgress {
   std::string validation_ = "val -";
 };
 
+// One row per epoch, for the model card.
+void writeHistoryCsv(const std::filesystem::path& path, const std::vector<EpochStats>& history) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "epoch,loss,triplet_loss,reconstruction_loss,val_top1,val_top5,val_queries,"
+           "learning_rate,seconds,best\n";
+    for (const EpochStats& e : history)
+      out << e.epoch << ',' << e.loss << ',' << e.triplet_loss << ',' << e.reconstruction_loss
+          << ',' << e.validation.top1 << ',' << e.validation.top5 << ',' << e.validation.queries
+          << ',' << e.learning_rate << ',' << e.seconds << ',' << (e.best ? 1 : 0) << '\n';
+  });
+}
+
 }  // namespace
 
 int runTrain(const std::vector<std::string>& args) {
   const CliArgs a(args,
                   {"descriptor", "dataset", "out", "epochs", "threads", "config", "batch",
-                   "max-frames", "cache", "anchors-per-epoch", "lr", "seed", "points"},
+                   "max-frames", "cache", "anchors-per-epoch", "lr", "seed", "points", "history"},
                   {});
-  TrainConfig config;
-  config.net.kind = parseDescriptorKind(a.require("descriptor"));
+  TrainConfig config = defaultTrainConfig(parseDescriptorKind(a.require("descriptor")));
   const std::vector<std::string> specs = splitDatasetSpecs(a.require("dataset"));
   const std::filesystem::path out = a.require("out");
   config.epochs = positiveInt(a, "epochs", config.epochs);
@@ -186,6 +198,10 @@ int runTrain(const std::vector<std::string>& args) {
   callbacks.epoch = [&](const EpochStats& s) { progress.epoch(s); };
   const TrainResult result = trainDescriptor(data, config, out, callbacks);
 
+  if (a.has("history")) {
+    writeHistoryCsv(a.require("history"), result.history);
+    std::cout << "wrote " << a.require("history") << "\n";
+  }
   std::printf("trained on %zu observations (%zu anchors), validated on %zu\n",
               result.train_observations, result.anchors, result.validation_observations);
   const EpochStats& best = result.history.at(static_cast<size_t>(result.best_epoch - 1));

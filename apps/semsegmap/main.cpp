@@ -23,9 +23,19 @@ commands:
                      any dataset written in the project's format
   segment            --dataset SPEC --config FILE --out DIR [--poses gt|odom] [--max-frames K]
                      enrichment + local map + incremental segmentation -> segments.csv/.ply/.png
+  map                --dataset SPEC --config FILE --out MAP [--poses gt|odom|slam]
+                     [--max-frames K] [--points N] [--float32]
+                     builds and saves a target map (N picture points per segment, default 0)
+  localize           --dataset SPEC --config FILE --map MAP --out DIR [--max-frames K]
+                     localizes a run against a target map -> localizations.csv, summary.json,
+                     localization.png
+  slam               --dataset SPEC --config FILE --out DIR [--max-frames K]
+                     mapping with loop closure on odometry -> trajectory_{tum,kitti}.txt,
+                     loops.csv, summary.json, slam.png
   train              --descriptor semsegmap-net|segmap-cnn --dataset SPEC[,SPEC...] --out FILE
                      [--epochs N] [--batch N] [--threads N] [--config FILE] [--max-frames K]
                      [--cache FILE] [--anchors-per-epoch N] [--lr X] [--seed N] [--points N]
+                     [--history FILE.csv]
                      trains a learned descriptor on simulated ground truth; a key=value after
                      a sim: spec belongs to it, any other item starts a new spec (';' also
                      separates): sim:world=1,run=S1,sim:world=1,run=S1,condition=sunrise
@@ -51,6 +61,9 @@ int main(int argc, char** argv) {
       {"enrich", semsegmap::app::runEnrich},
       {"convert", semsegmap::app::runConvert},
       {"segment", semsegmap::app::runSegment},
+      {"map", semsegmap::app::runMap},
+      {"localize", semsegmap::app::runLocalize},
+      {"slam", semsegmap::app::runSlam},
       {"train", semsegmap::app::runTrain},
       {"eval", semsegmap::app::runEval},
       {"demo", semsegmap::app::runDemo},

@@ -11,6 +11,10 @@ class Progress {
  public:
   Progress(std::string label, size_t total)
       : label_(std::move(label)), total_(total), start_(std::chrono::steady_clock::now()) {}
+  void update(size_t done, size_t total) {
+    total_ = total;
+    update(done);
+  }
   void update(size_t done) {
     const double elapsed = seconds();
     if (done < total_ && elapsed - last_ < 0.5) return;

@@ -54,7 +54,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
   if (!root.IsMap())
     throw std::runtime_error(path.string() + ": expected a mapping at the top level");
   const std::map<std::string, bool> sections = {
-      {"enrichment", true}, {"local_map", true}, {"segmentation", true}};
+      {"enrichment", true},   {"local_map", true},  {"segmentation", true}, {"descriptor", true},
+      {"localization", true}, {"target_map", true}, {"loop_closure", true}};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (!sections.count(key))
@@ -89,6 +90,33 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"observation_growth", set(sg.observation_growth)},
                {"keep_all_observation_points", set(sg.keep_all_observation_points)}});
 
+  auto& d = c.descriptor;
+  readSection(path, root, "descriptor",
+              {{"kind", set(d.kind)}, {"model", set(d.model)}, {"batch", set(d.batch)}});
+  // A model path in a config file is relative to the config file, so that the config works
+  // from any directory.
+  if (!d.model.empty() && std::filesystem::path(d.model).is_relative())
+    d.model = (path.parent_path() / d.model).lexically_normal().string();
+  auto& loc = c.localization;
+  readSection(path, root, "localization",
+              {{"k", set(loc.localizer.index.k)},
+               {"exact_below", set(loc.localizer.index.exact_below)},
+               {"resolution_m", set(loc.localizer.verification.resolution_m)},
+               {"min_inliers", set(loc.localizer.verification.min_inliers)},
+               {"min_local_segments", set(loc.localizer.min_local_segments)},
+               {"every_n_frames", set(loc.every_n_frames)}});
+  readSection(path, root, "target_map",
+              {{"duplicate_distance_m", set(c.target_map.duplicate_distance_m)},
+               {"max_points_per_segment", set(c.target_map.max_points_per_segment)}});
+  auto& lc = c.loop_closure;
+  readSection(path, root, "loop_closure",
+              {{"exclude_recent_m", set(lc.exclude_recent_m)},
+               {"min_travel_between_loops_m", set(lc.min_travel_between_loops_m)},
+               {"odometry_translation_sigma_m", set(lc.odometry_translation_sigma_m)},
+               {"odometry_rotation_sigma_rad", set(lc.odometry_rotation_sigma_rad)},
+               {"loop_translation_sigma_m", set(lc.loop_translation_sigma_m)},
+               {"loop_rotation_sigma_rad", set(lc.loop_rotation_sigma_rad)}});
+
   auto check = [&](bool ok, const std::string& what) {
     if (!ok) throw std::runtime_error(path.string() + ": " + what);
   };
@@ -104,6 +132,15 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
         "segmentation.min_segment_points: must not exceed max_segment_points");
   check(c.enrichment.occlusion_radius_px >= 0,
         "enrichment.occlusion_radius_px: must not be negative");
+  check(d.batch >= 1, "descriptor.batch: must be at least 1");
+  check(loc.localizer.index.k >= 1, "localization.k: must be at least 1");
+  check(loc.localizer.verification.resolution_m > 0, "localization.resolution_m: must be positive");
+  check(loc.localizer.verification.min_inliers >= 3,
+        "localization.min_inliers: must be at least 3 (a rigid transform needs 3 points)");
+  check(loc.every_n_frames >= 1, "localization.every_n_frames: must be at least 1");
+  check(c.target_map.duplicate_distance_m >= 0,
+        "target_map.duplicate_distance_m: must not be negative");
+  check(lc.exclude_recent_m >= 0, "loop_closure.exclude_recent_m: must not be negative");
   return c;
 }
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 
@@ -19,6 +20,7 @@ void checkConfig(const TrainConfig& c) {
   validateNetConfig(c.net);
   if (c.epochs < 1) fail("epochs must be at least 1");
   if (c.batch_size < 1) fail("batch size must be at least 1");
+  if (c.reconstruction_anchors < 0) fail("reconstruction anchors must not be negative");
   if (!(c.learning_rate > 0)) fail("learning rate must be positive");
   if (!(c.learning_rate_decay > 0)) fail("learning rate decay must be positive");
   if (c.threads < 1) fail("threads must be at least 1");
@@ -58,9 +60,9 @@ struct BatchLoss {
   torch::Tensor descriptors;  // [3B, D]: anchors, positives, negatives
 };
 
-// The loss of one batch of triplets. Only the anchors are decoded: the decoder costs more than
-// the encoder (twice as much for semsegmap-net, twenty times for segmap-cnn), and the loss
-// reconstructs the anchor.
+// The loss of one batch of triplets. Only (some of) the anchors are decoded: the decoder costs
+// more than the encoder (twice as much for semsegmap-net, twenty times for segmap-cnn), and the
+// loss reconstructs the anchor.
 BatchLoss batchLoss(DescriptorNetImpl& net, const TrainingSet& data, const std::vector<Triplet>& t,
                     const TrainConfig& config, bool augmented, std::mt19937& rng) {
   const size_t batch = t.size();
@@ -81,24 +83,41 @@ BatchLoss batchLoss(DescriptorNetImpl& net, const TrainingSet& data, const std::
   for (size_t b = 0; b < batch; ++b)
     sigma[b] = static_cast<float>(std::min(
         config.max_sigma, effective_points[batch + b] / std::max(1.0, effective_points[b])));
-  std::vector<const EnrichedCloud*> anchors, others;
-  for (size_t i = 0; i < clouds.size(); ++i) (i < batch ? anchors : others).push_back(&clouds[i]);
-
-  const NetInput anchor_input = makeNetInput(config.net, anchors, rng);
-  const NetOutput anchor_output = net.forward(anchor_input);
-  const torch::Tensor other = net.encode(makeNetInput(config.net, others, rng));
+  // Rows 0..B-1 anchors, B..2B-1 positives, 2B..3B-1 negatives; the first `decoded` go through
+  // the decoder too.
+  const size_t decoded = config.reconstruction_anchors > 0
+                             ? std::min(batch, static_cast<size_t>(config.reconstruction_anchors))
+                             : batch;
+  std::vector<const EnrichedCloud*> with_decoder, without;
+  for (size_t i = 0; i < clouds.size(); ++i)
+    (i < decoded ? with_decoder : without).push_back(&clouds[i]);
+  const NetInput decoded_input = makeNetInput(config.net, with_decoder, rng);
+  const NetOutput decoded_output = net.forward(decoded_input);
+  const torch::Tensor d =
+      torch::cat({decoded_output.descriptor, net.encode(makeNetInput(config.net, without, rng))});
   const int64_t B = static_cast<int64_t>(batch);
   BatchLoss loss;
   loss.triplet =
-      tripletLoss(anchor_output.descriptor, other.slice(0, 0, B), other.slice(0, B, 2 * B),
+      tripletLoss(d.slice(0, 0, B), d.slice(0, B, 2 * B), d.slice(0, 2 * B, 3 * B),
                   torch::from_blob(sigma.data(), {B}, torch::kFloat).clone(), config.margin);
-  loss.reconstruction = torch::binary_cross_entropy_with_logits(anchor_output.reconstruction,
-                                                                anchor_input.target_occupancy);
-  loss.descriptors = torch::cat({anchor_output.descriptor, other});
+  loss.reconstruction = torch::binary_cross_entropy_with_logits(decoded_output.reconstruction,
+                                                                decoded_input.target_occupancy);
+  loss.descriptors = d;
   return loss;
 }
 
 }  // namespace
+
+TrainConfig defaultTrainConfig(DescriptorKind kind) {
+  TrainConfig c;
+  c.net.kind = kind;
+  if (kind == DescriptorKind::kSegMapCnn) {
+    // A step costs three times semsegmap-net's even with 8 of 32 anchors decoded: fewer epochs.
+    c.reconstruction_anchors = 8;
+    c.epochs = 8;
+  }
+  return c;
+}
 
 Eigen::MatrixXf describeObservations(DescriptorNetImpl& net, const TrainingSet& data,
                                      const std::vector<size_t>& which, uint64_t seed,
@@ -129,14 +148,22 @@ Eigen::MatrixXf describeObservations(DescriptorNetImpl& net, const TrainingSet& 
 
 RetrievalAccuracy validationAccuracy(DescriptorNetImpl& net, const TrainingSet& data,
                                      const std::vector<size_t>& which, uint64_t seed,
-                                     size_t max_queries) {
+                                     size_t max_queries, double min_completeness) {
   const std::vector<int> labels = landmarkLabels(data);
   const std::vector<bool> final = finalObservations(data);
+  std::map<std::pair<uint16_t, int64_t>, uint32_t> final_points;
   std::vector<size_t> queries, database;
-  for (size_t i : which)
-    if (!final.at(i)) queries.push_back(i);
   for (size_t i = 0; i < final.size(); ++i)
-    if (final[i]) database.push_back(i);
+    if (final[i]) {
+      database.push_back(i);
+      const TrainingObservation& o = data.observations[i];
+      final_points[{o.source, o.segment}] = o.n_points;
+    }
+  for (size_t i : which) {
+    const TrainingObservation& o = data.observations.at(i);
+    if (!final[i] && o.n_points >= min_completeness * final_points[{o.source, o.segment}])
+      queries.push_back(i);
+  }
   if (queries.size() > max_queries) {
     std::mt19937 pick(static_cast<uint32_t>(seed));
     std::shuffle(queries.begin(), queries.end(), pick);
@@ -230,6 +257,8 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
         t.anchor = order.back();
         order.pop_back();
         t.positive = sampler.positive(t.anchor, rng);
+        if (data.observations[t.positive].n_points > data.observations[t.anchor].n_points)
+          std::swap(t.anchor, t.positive);
         t.negative = sampler.negative(t.anchor, rng);
         if (!mine || !is_cached[t.anchor]) continue;
         float hardest = cachedDistance(t.anchor, t.negative);
@@ -267,8 +296,9 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
     stats.triplet_loss = triplet_mean.value();
     stats.reconstruction_loss = recon_mean.value();
     stats.learning_rate = learning_rate;
-    stats.validation = validationAccuracy(*net, data, split.validation, config.seed,
-                                          config.max_validation_queries);
+    stats.validation =
+        validationAccuracy(*net, data, split.validation, config.seed, config.max_validation_queries,
+                           config.validation_min_completeness);
     // Without validation queries (tiny data), the training loss is all there is to go by.
     const double score = stats.validation.queries > 0 ? stats.validation.top1 : -stats.loss;
     if (score > best_score) {

@@ -26,19 +26,34 @@ struct TrainConfig {
   double learning_rate_decay = 1.0;  // multiplies the learning rate after every epoch
   double margin = 0.4;               // the paper's m
   double reconstruction_weight = 0.1;
-  // sigma = points(P) / points(A) is capped: a 100-point anchor with a 10000-point positive
-  // would otherwise weigh a hundred times the rest of its batch.
-  double max_sigma = 4.0;
+  // Anchors of a batch that are decoded for the reconstruction loss (0: all). The decoder costs
+  // more than the encoder, twenty times for segmap-cnn's 32x32x16 grid: a few anchors keep the
+  // regularisation at a fraction of the time.
+  int reconstruction_anchors = 0;
+  // Of a positive pair, the observation with more points is the anchor, so that
+  // sigma = points(P) / points(A) <= 1 weighs a pair by how complete its smaller half is: the
+  // paper's heuristic against penalising pairs that share little. (Drawn the other way round, a
+  // 100-point anchor with a 10000-point positive would weigh a hundred times the rest of its
+  // batch.) The cap only trims what the augmentation's cuts and drops add to the ratio.
+  double max_sigma = 1.0;
   int warmup_epochs = 1;  // random negatives; afterwards the hardest of the candidates below
   int hard_negative_candidates = 8;
   double validation_fraction = 0.1;      // of the instances
   uint64_t split_seed = 1;               // which instances are held out
   size_t max_validation_queries = 4000;  // random subset beyond (retrieval is quadratic)
-  int threads = 2;                       // torch::set_num_threads
+  // Queries less complete than this are left out of the validation: below half of its final
+  // points a segment is mostly a fragment that matches by luck, and the sigma weighting
+  // deliberately trains for the more complete ones.
+  double validation_min_completeness = 0.5;
+  int threads = 2;    // torch::set_num_threads
   uint64_t seed = 1;  // weights, sampling, augmentation: the same seed gives the same model
   bool augment = true;
   AugmentConfig augmentation;
 };
+
+// The recipe of the shipped models for `kind`: sized to train in well under 90 minutes on two
+// cores, extraction of S1 included (models/MODEL_CARD.md).
+TrainConfig defaultTrainConfig(DescriptorKind kind);
 
 struct EpochStats {
   int epoch = 0;                                                     // from 1
@@ -78,14 +93,15 @@ Eigen::MatrixXf describeObservations(DescriptorNetImpl& net, const TrainingSet& 
 
 // Validation retrieval accuracy of `net`, as a localization would use the descriptor: the final
 // (most complete) observation of every segment in `data` forms the database (the target map; the
-// training landmarks are its distractors), and every earlier observation among `which` is a
-// query that must find its landmark (landmarkLabels) there. Comparing every observation with
-// every other instead would be trivial with several runs on one trajectory: the other
-// condition's observation of a segment at the same frame has the same points, only other
-// colours. At most `max_queries`, a fixed random subset.
+// training landmarks are its distractors), and every earlier observation among `which` that has
+// at least `min_completeness` of its segment's final points is a query that must find its
+// landmark (landmarkLabels) there. Comparing every observation with every other instead would be
+// trivial with several runs on one trajectory: the other condition's observation of a segment at
+// the same frame has the same points, only other colours. At most `max_queries`, a fixed random
+// subset.
 RetrievalAccuracy validationAccuracy(DescriptorNetImpl& net, const TrainingSet& data,
                                      const std::vector<size_t>& which, uint64_t seed,
-                                     size_t max_queries = 4000);
+                                     size_t max_queries = 4000, double min_completeness = 0.5);
 
 struct Triplet {
   size_t anchor = 0, positive = 0, negative = 0;  // indices into TrainingSet::observations

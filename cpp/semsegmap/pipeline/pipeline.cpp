@@ -1,5 +1,6 @@
 #include "semsegmap/pipeline/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -11,18 +12,78 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
+StageTimes& StageTimes::operator+=(const StageTimes& o) {
+  enrich_ms += o.enrich_ms;
+  local_map_ms += o.local_map_ms;
+  segment_ms += o.segment_ms;
+  describe_ms += o.describe_ms;
+  localize_ms += o.localize_ms;
+  return *this;
+}
+
 PoseSource parsePoseSource(const std::string& name) {
   if (name == "gt") return PoseSource::kGroundTruth;
   if (name == "odom") return PoseSource::kOdometry;
   throw std::invalid_argument("unknown pose source '" + name + "' (expected gt or odom)");
 }
 
-Pipeline::Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses)
+Pipeline::Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
+                   Describer* describer)
     : config_(config),
       info_(info),
       poses_(poses),
       local_map_(config.local_map, info.classes),
-      segmenter_(config.segmentation) {}
+      segmenter_(config.segmentation),
+      describer_(describer) {}
+
+void Pipeline::setLocalizer(const Localizer* localizer, const std::vector<bool>* usable) {
+  if (localizer && !describer_)
+    throw std::invalid_argument("a localizing pipeline needs a describer");
+  localizer_ = localizer;
+  usable_ = usable;
+}
+
+void Pipeline::describe(const std::vector<SegmentId>& ids, size_t frame_index) {
+  const size_t batch = static_cast<size_t>(std::max(1, config_.descriptor.batch));
+  for (size_t start = 0; start < ids.size(); start += batch) {
+    const size_t end = std::min(ids.size(), start + batch);
+    std::vector<DescriptorInput> inputs;
+    std::vector<const Segment*> segments;
+    for (size_t i = start; i < end; ++i) {
+      const Segment* s = segmenter_.segment(ids[i]);
+      if (!s || s->observations.empty() || s->last().points.empty()) continue;
+      segments.push_back(s);
+      inputs.push_back({&s->last().points});
+    }
+    if (inputs.empty()) continue;
+    const Eigen::MatrixXf d = describer_->describe(inputs);
+    for (size_t i = 0; i < segments.size(); ++i) {
+      const SegmentObservation& o = segments[i]->last();
+      DescribedSegment& e = described_[segments[i]->id];
+      e.id = segments[i]->id;
+      e.centroid = o.centroid.cast<float>();
+      e.n_points = static_cast<uint32_t>(o.n_points);
+      e.majority_class = o.majority_class;
+      e.frame_index = frame_index;
+      e.descriptor = d.row(static_cast<Eigen::Index>(i)).transpose();
+    }
+  }
+}
+
+std::optional<Localization> Pipeline::query(std::vector<SegmentId>& ids) const {
+  ids.clear();
+  for (const auto& [id, e] : described_) ids.push_back(id);
+  std::sort(ids.begin(), ids.end());  // a deterministic query order
+  std::vector<Eigen::Vector3f> centroids;
+  Eigen::MatrixXf descriptors(static_cast<Eigen::Index>(ids.size()),
+                              ids.empty() ? 0 : described_.at(ids[0]).descriptor.size());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const DescribedSegment& e = described_.at(ids[i]);
+    centroids.push_back(e.centroid);
+    descriptors.row(static_cast<Eigen::Index>(i)) = e.descriptor.transpose();
+  }
+  return localizer_->localize(centroids, descriptors, usable_);
+}
 
 FrameResult Pipeline::process(const Frame& frame) {
   FrameResult r;
@@ -55,7 +116,54 @@ FrameResult Pipeline::process(const Frame& frame) {
   t0 = std::chrono::steady_clock::now();
   r.segmentation = segmenter_.update(local_map_, r.map_update, frame.index, frame.timestamp_s);
   r.times.segment_ms = msSince(t0);
+  ++frames_;
+  if (!describer_) return r;
+
+  // Only segments whose observation changed are described again: most of the local map is the
+  // same from one frame to the next.
+  t0 = std::chrono::steady_clock::now();
+  for (const SegmentMerge& m : r.segmentation.merges) described_.erase(m.absorbed);
+  describe(r.segmentation.observed, frame.index);
+  r.described = r.segmentation.observed.size();
+  for (const Segment& s : r.segmentation.finished) {
+    auto it = described_.find(s.id);
+    if (it == described_.end() || it->second.n_points != s.last().n_points) {
+      // Not described in its final state (cannot happen with the segmenter's current rules, but
+      // a finished segment must never leave without its descriptor).
+      const DescriptorInput in{&s.last().points};
+      r.finished_descriptors.push_back(describer_->describe({in}).row(0).transpose());
+    } else {
+      r.finished_descriptors.push_back(it->second.descriptor);
+    }
+    described_.erase(s.id);
+  }
+  r.times.describe_ms = msSince(t0);
+
+  if (localizer_ && (frames_ - 1) % std::max<size_t>(1, config_.localization.every_n_frames) == 0) {
+    t0 = std::chrono::steady_clock::now();
+    r.localization = query(r.query_segments);
+    r.times.localize_ms = msSince(t0);
+  }
   return r;
+}
+
+std::vector<Segment> Pipeline::finish(std::vector<Eigen::VectorXf>* descriptors) {
+  std::vector<Segment> segments = segmenter_.finishAll();
+  if (descriptors) {
+    descriptors->clear();
+    if (!describer_) throw std::logic_error("Pipeline::finish: descriptors need a describer");
+    for (const Segment& s : segments) {
+      auto it = described_.find(s.id);
+      if (it != described_.end() && it->second.n_points == s.last().n_points) {
+        descriptors->push_back(it->second.descriptor);
+      } else {
+        const DescriptorInput in{&s.last().points};
+        descriptors->push_back(describer_->describe({in}).row(0).transpose());
+      }
+    }
+  }
+  described_.clear();
+  return segments;
 }
 
 }  // namespace semsegmap

@@ -2,16 +2,44 @@
 // the code that uses it. io/config.h reads it from YAML.
 #pragma once
 
+#include <string>
+
 #include "semsegmap/enrich/enricher.h"
 #include "semsegmap/local_map/local_map.h"
+#include "semsegmap/localize/localizer.h"
+#include "semsegmap/localize/target_map.h"
 #include "semsegmap/segment/semantic_distance.h"
 
 namespace semsegmap {
+
+struct DescriptorConfig {
+  std::string kind = "semsegmap-net";  // descriptorName(): semsegmap-net, segmap-cnn, eigen, fpfh
+  std::string model;  // model file of a learned descriptor; in YAML relative to the config file
+  int batch = 64;     // segments described per forward pass
+};
+
+struct LocalizationConfig {
+  LocalizerConfig localizer;
+  size_t every_n_frames = 1;  // query the target map every n-th frame
+};
+
+struct LoopClosureConfig {
+  // Segments finished within this many metres of driving before now are not loop candidates:
+  // matching the robot against what it has just seen would only confirm odometry.
+  double exclude_recent_m = 60.0;
+  double min_travel_between_loops_m = 5.0;  // one loop edge per place, not one per frame
+  double odometry_translation_sigma_m = 0.05, odometry_rotation_sigma_rad = 0.005;
+  double loop_translation_sigma_m = 0.3, loop_rotation_sigma_rad = 0.02;
+};
 
 struct PipelineConfig {
   EnrichmentConfig enrichment;
   LocalMapConfig local_map;
   SegmentationConfig segmentation;
+  DescriptorConfig descriptor;
+  LocalizationConfig localization;
+  TargetMapBuilderConfig target_map;
+  LoopClosureConfig loop_closure;
 };
 
 }  // namespace semsegmap

@@ -1,0 +1,91 @@
+// The whole pipeline per frame on simulated S2 frames (full world), as a robot runs it while
+// localizing: enrichment, local map, segmentation, describing the changed segments with the
+// shipped model and querying a target map (built from the same stretch at sunrise beforehand,
+// untimed). Semantic segmentation of the images is not included, as in the paper (its labels
+// come from the simulator). Target: at least 20 Hz on 2 cores.
+#include <benchmark/benchmark.h>
+
+#include "semsegmap/io/config.h"
+#include "semsegmap/pipeline/modes.h"
+#include "semsegmap/sim/simulator.h"
+
+using namespace semsegmap;
+
+namespace {
+
+class Recorded : public FrameSource {
+ public:
+  Recorded(std::vector<Frame> frames, DatasetInfo info)
+      : frames_(std::move(frames)), info_(std::move(info)) {}
+  const DatasetInfo& info() const override { return info_; }
+  size_t size() const override { return frames_.size(); }
+  Frame frame(size_t i) override { return frames_.at(i); }
+  const Frame& at(size_t i) const { return frames_.at(i); }
+
+ private:
+  std::vector<Frame> frames_;
+  DatasetInfo info_;
+};
+
+// 80 consecutive S2 frames, rendered once.
+Recorded s2Frames(const std::string& condition, uint64_t traffic) {
+  sim::SimConfig c;
+  c.run = sim::Run::S2;
+  c.condition = condition;
+  c.traffic_seed = traffic;
+  c.max_frames = 80;
+  sim::Simulator s(c);
+  std::vector<Frame> frames;
+  for (size_t i = 0; i < s.size(); ++i) frames.push_back(s.frame(i));
+  return Recorded(std::move(frames), s.info());
+}
+
+void BM_WholePipeline(benchmark::State& state) {
+  const std::string name = state.range(0) == 0 ? "semsegmap" : "segmap";
+  const PipelineConfig config =
+      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/" + name + ".yaml");
+  std::unique_ptr<Describer> describer;
+  try {
+    describer = makeDescriber(config.descriptor);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  static Recorded mapping = s2Frames("sunrise", 11);
+  static Recorded query = s2Frames("sunny", 12);
+  const TargetMap map = runMapping(mapping, config, PoseSource::kGroundTruth, *describer).map;
+  const Localizer localizer(map, config.localization.localizer);
+  std::unique_ptr<Pipeline> pipeline;
+  size_t i = 0, localized = 0, frames = 0;
+  StageTimes total;
+  for (auto _ : state) {
+    if (!pipeline || i == query.size()) {
+      state.PauseTiming();
+      pipeline =
+          std::make_unique<Pipeline>(config, query.info(), PoseSource::kOdometry, describer.get());
+      pipeline->setLocalizer(&localizer);
+      i = 0;
+      state.ResumeTiming();
+    }
+    const FrameResult r = pipeline->process(query.at(i++));
+    localized += r.localization.has_value();
+    total += r.times;
+    ++frames;
+  }
+  state.SetLabel(name + " + " + config.descriptor.kind);
+  const double n = static_cast<double>(std::max<size_t>(1, frames));
+  state.counters["localized"] = static_cast<double>(localized) / n;
+  state.counters["enrich_ms"] = total.enrich_ms / n;
+  state.counters["map_seg_ms"] = (total.local_map_ms + total.segment_ms) / n;
+  state.counters["describe_ms"] = total.describe_ms / n;
+  state.counters["localize_ms"] = total.localize_ms / n;
+  state.counters["Hz"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_WholePipeline)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(160);
+
+}  // namespace

@@ -1,0 +1,52 @@
+#include "semsegmap/localize/localizer.h"
+
+#include <stdexcept>
+
+namespace semsegmap {
+
+Localizer::Localizer(const TargetMap& map, const LocalizerConfig& config)
+    : map_(map), config_(config), index_(config.index) {
+  if (map.descriptors.rows() > 0) index_.build(map.descriptors);
+}
+
+std::optional<Localization> Localizer::localize(const std::vector<Eigen::Vector3f>& centroids,
+                                                const Eigen::MatrixXf& descriptors,
+                                                const std::vector<bool>* usable) const {
+  if (static_cast<size_t>(descriptors.rows()) != centroids.size())
+    throw std::invalid_argument("localize: one descriptor per centroid expected");
+  if (centroids.size() < config_.min_local_segments || map_.size() == 0) return std::nullopt;
+  // With a mask, ask for more neighbours so that masked-out ones do not crowd out the rest.
+  const int k = config_.index.k;
+  const int k_search = usable ? std::min<int>(4 * k, static_cast<int>(map_.size())) : k;
+  const Neighbours nn = index_.search(descriptors, k_search);
+  std::vector<Correspondence> candidates;
+  for (size_t q = 0; q < centroids.size(); ++q) {
+    int kept = 0;
+    for (int j = 0; j < nn.k && kept < k; ++j) {
+      const int64_t id = nn.ids[q * static_cast<size_t>(nn.k) + static_cast<size_t>(j)];
+      if (id < 0) break;
+      if (usable && !(*usable)[static_cast<size_t>(id)]) continue;
+      ++kept;
+      Correspondence c;
+      c.local = centroids[q].cast<double>();
+      c.target = map_.segments[static_cast<size_t>(id)].centroid.cast<double>();
+      c.local_id = static_cast<int64_t>(q);
+      c.target_id = id;
+      c.descriptor_distance = nn.squared_distances[q * static_cast<size_t>(nn.k) + j];
+      candidates.push_back(c);
+    }
+  }
+  const VerificationResult v = verify(candidates, config_.verification);
+  if (!v.found) return std::nullopt;
+  Localization out;
+  out.T_map_local = v.T_target_local;
+  out.inliers = static_cast<int>(v.inliers.size());
+  out.candidates = candidates.size();
+  for (int i : v.inliers) {
+    const Correspondence& c = candidates[static_cast<size_t>(i)];
+    out.matches.emplace_back(static_cast<size_t>(c.local_id), static_cast<size_t>(c.target_id));
+  }
+  return out;
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,36 @@
+// The saved target map: a versioned little-endian binary file (docs/map-format.md), descriptors
+// as float16 by default (about 146 bytes a segment with 64-d descriptors), an FNV-1a checksum
+// at the end, written to a temporary name and renamed.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "semsegmap/localize/target_map.h"
+
+namespace semsegmap {
+
+constexpr uint32_t kMapFormatVersion = 1;
+
+struct MapWriteOptions {
+  bool float16 = true;  // halves the size; retrieval ranks are unchanged in practice
+};
+
+// Returns the number of bytes written. Throws std::runtime_error naming `path` on failure.
+uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
+                       const MapWriteOptions& options = {});
+// Throws std::runtime_error "<path>: <what is wrong>" for a missing, truncated or corrupt file or
+// one of another format version.
+TargetMap loadTargetMap(const std::filesystem::path& path);
+
+// Throws std::runtime_error "<path>: ..." when the map's descriptors cannot be compared with those
+// of the running describer (another descriptor kind, dimension or model).
+void checkMapCompatible(const std::filesystem::path& path, const TargetMap& map,
+                        const std::string& descriptor, const std::string& fingerprint,
+                        int dimension);
+
+// FNV-1a, 64 bit: every single-byte change changes it.
+uint64_t fnv1a64(const char* data, size_t size);
+
+}  // namespace semsegmap

@@ -1,0 +1,67 @@
+#include "semsegmap/localize/target_map.h"
+
+#include <stdexcept>
+
+namespace semsegmap {
+
+TargetMapBuilder::TargetMapBuilder(std::string descriptor, std::string fingerprint, int dimension,
+                                   const TargetMapBuilderConfig& config)
+    : descriptor_(std::move(descriptor)),
+      fingerprint_(std::move(fingerprint)),
+      dimension_(dimension),
+      config_(config) {
+  if (dimension_ < 1) throw std::invalid_argument("target map: descriptor dimension must be >= 1");
+}
+
+void TargetMapBuilder::add(const MapSegment& segment, const Eigen::VectorXf& descriptor) {
+  if (descriptor.size() != dimension_)
+    throw std::invalid_argument("target map: descriptor of dimension " +
+                                std::to_string(descriptor.size()) + ", expected " +
+                                std::to_string(dimension_));
+  if (!segment.centroid.allFinite() || !descriptor.allFinite())
+    throw std::invalid_argument("target map: segment with a non-finite centroid or descriptor");
+  // Maps hold thousands of segments and a run adds them one by one: a linear scan is cheap
+  // next to describing the segment.
+  const float d2 = static_cast<float>(config_.duplicate_distance_m * config_.duplicate_distance_m);
+  if (config_.duplicate_distance_m > 0)
+    for (size_t i = 0; i < segments_.size(); ++i)
+      if (alive_[i] && (segments_[i].centroid - segment.centroid).squaredNorm() < d2) {
+        alive_[i] = false;
+        ++duplicates_;
+      }
+  MapSegment kept = segment;
+  kept.points = subsamplePoints(segment.points, config_.max_points_per_segment);
+  segments_.push_back(std::move(kept));
+  descriptors_.push_back(descriptor);
+  alive_.push_back(true);
+}
+
+TargetMap TargetMapBuilder::build() const {
+  TargetMap map;
+  map.descriptor = descriptor_;
+  map.fingerprint = fingerprint_;
+  size_t n = 0;
+  for (bool a : alive_) n += a;
+  map.descriptors.resize(static_cast<Eigen::Index>(n), dimension_);
+  map.segments.reserve(n);
+  for (size_t i = 0; i < segments_.size(); ++i) {
+    if (!alive_[i]) continue;
+    map.descriptors.row(static_cast<Eigen::Index>(map.segments.size())) =
+        descriptors_[i].transpose();
+    map.segments.push_back(segments_[i]);
+  }
+  return map;
+}
+
+std::vector<Eigen::Vector3f> subsamplePoints(const std::vector<Eigen::Vector3f>& points,
+                                             size_t max_points) {
+  if (max_points == 0 || points.empty()) return {};
+  if (points.size() <= max_points) return points;
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(max_points);
+  // Evenly spaced indices: deterministic, and covers the whole segment.
+  for (size_t i = 0; i < max_points; ++i) out.push_back(points[i * points.size() / max_points]);
+  return out;
+}
+
+}  // namespace semsegmap

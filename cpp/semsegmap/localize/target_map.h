@@ -1,0 +1,65 @@
+// The target map (paper section III-D): what a robot localizes against. Per segment only what
+// localization needs: the descriptor of its final (most complete) observation, its centroid in
+// the map frame, its majority class and size. Points are optional and for pictures only.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "semsegmap/core/class_table.h"
+
+namespace semsegmap {
+
+struct MapSegment {
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();  // map frame
+  uint32_t n_points = 0;
+  ClassId majority_class = cls::kUnknown;
+  std::vector<Eigen::Vector3f> points;  // optional: a subsample, map frame
+};
+
+struct TargetMap {
+  std::string descriptor;   // descriptorName(): "semsegmap-net", "segmap-cnn", "eigen", "fpfh"
+  std::string fingerprint;  // Describer::fingerprint(): the exact model the descriptors came from
+  std::vector<MapSegment> segments;
+  Eigen::MatrixXf descriptors;  // one row per segment
+
+  size_t size() const { return segments.size(); }
+  int dimension() const { return static_cast<int>(descriptors.cols()); }
+};
+
+struct TargetMapBuilderConfig {
+  // A segment whose centroid lies within this distance of a segment added earlier replaces it:
+  // the same object segmented again on a revisit (SegMap kept only the newest of such
+  // duplicates), and the newer one saw at least as much of the place. 0 disables the filter.
+  double duplicate_distance_m = 0.5;
+  size_t max_points_per_segment = 0;  // points kept per segment for pictures (0: none)
+};
+
+// Collects finished segments of a mapping run into a target map.
+class TargetMapBuilder {
+ public:
+  TargetMapBuilder(std::string descriptor, std::string fingerprint, int dimension,
+                   const TargetMapBuilderConfig& config = {});
+  // `descriptor` has `dimension` entries; `points` may be empty.
+  void add(const MapSegment& segment, const Eigen::VectorXf& descriptor);
+  size_t duplicatesRemoved() const { return duplicates_; }
+  TargetMap build() const;
+
+ private:
+  std::string descriptor_, fingerprint_;
+  int dimension_;
+  TargetMapBuilderConfig config_;
+  std::vector<MapSegment> segments_;
+  std::vector<Eigen::VectorXf> descriptors_;
+  std::vector<bool> alive_;
+  size_t duplicates_ = 0;
+};
+
+// At most `max_points` evenly spaced points of `points` (the optional picture points).
+std::vector<Eigen::Vector3f> subsamplePoints(const std::vector<Eigen::Vector3f>& points,
+                                             size_t max_points);
+
+}  // namespace semsegmap

@@ -1,0 +1,74 @@
+// The pipeline's three jobs (paper section III-D) as functions over a frame source: build a
+// target map from a mapping run, localize a run against a target map, and (pipeline/slam.h)
+// close loops while mapping. The apps only parse arguments and write files around these.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "semsegmap/pipeline/pipeline.h"
+
+namespace semsegmap {
+
+// The describer a configuration asks for (descriptor.kind, descriptor.model).
+std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int threads = 0);
+
+struct RunOptions {
+  size_t max_frames = 0;                                    // 0: all
+  std::function<void(size_t done, size_t total)> progress;  // optional
+};
+
+struct RunStats {
+  size_t frames = 0;
+  StageTimes total;  // summed over frames; the pipeline alone, not reading or simulating data
+  double fps() const { return total.total() > 0 ? 1000.0 * frames / total.total() : 0.0; }
+};
+
+struct MappingRun {
+  TargetMap map;
+  std::vector<Pose> trajectory;  // the poses the map was built with
+  size_t segments = 0;           // finished segments before removing duplicates
+  size_t duplicates_removed = 0;
+  RunStats stats;
+};
+
+// Maps the run with poses from ground truth or odometry (for the loop-closed trajectory, see
+// runSlam). Keeps config.target_map.max_points_per_segment picture points per segment.
+MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
+                      Describer& describer, const RunOptions& options = {});
+
+struct LocalizationRecord {
+  size_t frame_index = 0;
+  double timestamp_s = 0.0;
+  Pose T_map_robot = Pose::Identity();
+  int inliers = 0;
+  size_t candidates = 0;
+  std::optional<Pose> T_map_robot_gt;  // when the dataset has ground truth (map frame = world)
+  double translation_error_m = 0.0, rotation_error_deg = 0.0;  // only with ground truth
+  // Matched centroids: the local one carried into the map by the estimate, and the target's.
+  std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> matches;
+};
+
+struct LocalizationRun {
+  std::vector<LocalizationRecord> localizations;
+  std::vector<Pose> trajectory_gt;    // empty without ground truth
+  std::vector<Pose> trajectory_odom;  // the robot's own estimate, in its odometry frame
+  double distance_m = 0.0;            // driven, by odometry
+  RunStats stats;
+};
+
+// Localizes every frame's local segment map (built on odometry, as a robot would) against
+// `map`; checks the describer against the map first (kind, dimension and model).
+LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
+                                const TargetMap& map, Describer& describer,
+                                const RunOptions& options = {});
+
+struct LocalizationSummary {
+  size_t localizations = 0, below_1m = 0, below_5m = 0;
+  double mean_translation_error_m = 0.0, mean_rotation_error_deg = 0.0;
+};
+LocalizationSummary summarize(const std::vector<LocalizationRecord>& records);
+
+}  // namespace semsegmap

@@ -1,0 +1,168 @@
+// Target maps: building (duplicates), the saved file (round trip, float16, truncation, bit
+// flips, other versions) and the compatibility check against the running describer.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/localize/map_file.h"
+
+namespace semsegmap {
+namespace {
+
+std::filesystem::path tempPath(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / "semsegmap_test_target_map";
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+TargetMap randomMap(size_t n, int dim, bool points, uint32_t seed = 7) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  TargetMap map;
+  map.descriptor = "semsegmap-net";
+  map.fingerprint = "0123456789abcdef";
+  map.descriptors.resize(static_cast<Eigen::Index>(n), dim);
+  for (size_t i = 0; i < n; ++i) {
+    MapSegment s;
+    s.centroid = Eigen::Vector3f(100 * g(rng), 100 * g(rng), g(rng));
+    s.n_points = 100 + static_cast<uint32_t>(i);
+    s.majority_class = static_cast<ClassId>(i % 20);
+    if (points)
+      for (int k = 0; k < 10; ++k)
+        s.points.push_back(s.centroid + Eigen::Vector3f(g(rng), g(rng), g(rng)));
+    map.segments.push_back(s);
+    for (int k = 0; k < dim; ++k) map.descriptors(static_cast<Eigen::Index>(i), k) = g(rng);
+  }
+  return map;
+}
+
+std::string expectLoadError(const std::filesystem::path& path) {
+  try {
+    loadTargetMap(path);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "loading " << path << " did not fail";
+  return "";
+}
+
+TEST(MapFile, RoundTripIsExactUpToFloat16) {
+  const TargetMap map = randomMap(500, 64, true);
+  const auto path = tempPath("roundtrip.map");
+  const uint64_t bytes = saveTargetMap(path, map);
+  EXPECT_EQ(bytes, std::filesystem::file_size(path));
+  const TargetMap back = loadTargetMap(path);
+  EXPECT_EQ(back.descriptor, map.descriptor);
+  EXPECT_EQ(back.fingerprint, map.fingerprint);
+  ASSERT_EQ(back.size(), map.size());
+  ASSERT_EQ(back.dimension(), 64);
+  for (size_t i = 0; i < map.size(); ++i) {
+    EXPECT_EQ(back.segments[i].centroid, map.segments[i].centroid);  // float32: exact
+    EXPECT_EQ(back.segments[i].n_points, map.segments[i].n_points);
+    EXPECT_EQ(back.segments[i].majority_class, map.segments[i].majority_class);
+    ASSERT_EQ(back.segments[i].points.size(), 10u);
+    EXPECT_LT((back.segments[i].points[3] - map.segments[i].points[3]).norm(), 0.01f);
+  }
+  // float16 keeps 11 significant bits: relative error at most 2^-11.
+  const Eigen::MatrixXf diff = (back.descriptors - map.descriptors).cwiseAbs();
+  const Eigen::MatrixXf bound = map.descriptors.cwiseAbs() * (1.0f / 2048.0f);
+  EXPECT_TRUE((diff.array() <= bound.array() + 1e-7f).all());
+  EXPECT_GT(diff.maxCoeff(), 0.0f);  // it really is float16
+
+  MapWriteOptions f32;
+  f32.float16 = false;
+  saveTargetMap(path, map, f32);
+  EXPECT_EQ(loadTargetMap(path).descriptors, map.descriptors);
+}
+
+TEST(MapFile, SizeIsAtMost150BytesASegmentWith64dDescriptors) {
+  const TargetMap map = randomMap(10000, 64, false);
+  const auto path = tempPath("size.map");
+  const uint64_t bytes = saveTargetMap(path, map);
+  EXPECT_LE(static_cast<double>(bytes) / 10000.0, 150.0);
+}
+
+TEST(MapFile, TruncatedOrCorruptFilesAreRejectedNamingTheFile) {
+  const auto path = tempPath("good.map");
+  saveTargetMap(path, randomMap(50, 16, false));
+  const std::string good = readFileBytes(path);
+
+  const auto truncated = tempPath("truncated.map");
+  writeBytesAtomically(truncated, good.substr(0, good.size() - 100));
+  std::string error = expectLoadError(truncated);
+  EXPECT_NE(error.find(truncated.string()), std::string::npos) << error;
+
+  // Every single flipped bit in the body is caught (checksum or header check).
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::string bad = good;
+    const size_t at = std::uniform_int_distribution<size_t>(0, bad.size() - 1)(rng);
+    bad[at] = static_cast<char>(bad[at] ^ (1 << (trial % 8)));
+    const auto flipped = tempPath("flipped.map");
+    writeBytesAtomically(flipped, bad);
+    error = expectLoadError(flipped);
+    EXPECT_NE(error.find(flipped.string()), std::string::npos) << error;
+  }
+
+  const auto empty = tempPath("empty.map");
+  writeBytesAtomically(empty, "");
+  EXPECT_NE(expectLoadError(empty).find("not a semsegmap map"), std::string::npos);
+  EXPECT_NE(expectLoadError(tempPath("missing.map")).find("missing.map"), std::string::npos);
+}
+
+TEST(MapFile, AnotherFormatVersionIsRejectedWithItsNumber) {
+  const auto path = tempPath("version.map");
+  saveTargetMap(path, randomMap(5, 8, false));
+  std::string bytes = readFileBytes(path);
+  const uint32_t other = kMapFormatVersion + 1;
+  std::memcpy(&bytes[8], &other, sizeof(other));
+  // Re-sign, so that only the version is wrong.
+  const uint64_t sum = fnv1a64(bytes.data(), bytes.size() - 8);
+  std::memcpy(&bytes[bytes.size() - 8], &sum, sizeof(sum));
+  writeBytesAtomically(path, bytes);
+  const std::string error = expectLoadError(path);
+  EXPECT_NE(error.find("version " + std::to_string(other)), std::string::npos) << error;
+}
+
+TEST(MapFile, CompatibilityNamesWhatDiffers) {
+  const TargetMap map = randomMap(3, 64, false);
+  EXPECT_NO_THROW(checkMapCompatible("m.map", map, "semsegmap-net", "0123456789abcdef", 64));
+  auto message = [&](const std::string& kind, const std::string& fp, int dim) {
+    try {
+      checkMapCompatible("m.map", map, kind, fp, dim);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message("segmap-cnn", "0123456789abcdef", 64).find("segmap-cnn"), std::string::npos);
+  EXPECT_NE(message("semsegmap-net", "ffffffffffffffff", 64).find("model"), std::string::npos);
+  EXPECT_NE(message("semsegmap-net", "0123456789abcdef", 32).find("dimension"), std::string::npos);
+}
+
+TEST(TargetMapBuilder, ANewerSegmentReplacesADuplicateAtTheSamePlace) {
+  TargetMapBuilderConfig config;
+  config.duplicate_distance_m = 0.5;
+  TargetMapBuilder builder("eigen", "x", 2, config);
+  MapSegment a, b, c;
+  a.centroid = {0, 0, 0};
+  b.centroid = {10, 0, 0};
+  c.centroid = {0.3f, 0, 0};  // the first one again
+  builder.add(a, Eigen::Vector2f(1, 1));
+  builder.add(b, Eigen::Vector2f(2, 2));
+  builder.add(c, Eigen::Vector2f(3, 3));
+  const TargetMap map = builder.build();
+  EXPECT_EQ(builder.duplicatesRemoved(), 1u);
+  ASSERT_EQ(map.size(), 2u);
+  EXPECT_EQ(map.segments[0].centroid, b.centroid);
+  EXPECT_EQ(map.segments[1].centroid, c.centroid);
+  EXPECT_EQ(map.descriptors(1, 0), 3.0f);
+  EXPECT_THROW(builder.add(a, Eigen::Vector3f(1, 1, 1)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace semsegmap
