@@ -10,6 +10,7 @@
 #include "semsegmap/eval/descriptor_eval.h"
 #include "semsegmap/io/atomic_file.h"
 #include "semsegmap/io/config.h"
+#include "semsegmap/viz/plot.h"
 
 namespace semsegmap::app {
 
@@ -67,8 +68,24 @@ int runEvalDescriptors(const std::vector<std::string>& args) {
     json << (b ? ", " : "") << "\"" << bands[b].name << "\"";
   json << "],\n  \"descriptors\": [\n";
   std::printf("%-14s %7s %7s  %s\n", "descriptor", "top-1", "top-16", "segments/s");
+  // One panel per completeness band, one curve per descriptor: the paper's retrieval figure.
+  std::vector<viz::Panel> panels(bands.size());
+  for (size_t b = 0; b < bands.size(); ++b) {
+    panels[b].title = "completeness " + bands[b].name;
+    panels[b].xlabel = "k (nearest target descriptors)";
+    panels[b].ylabel = "fraction of true matches within k";
+    panels[b].log_x = true;
+  }
   for (size_t d = 0; d < describers.size(); ++d) {
     const DescriptorRetrieval r = evaluateRetrieval(*describers[d], set, q, bands, max_k);
+    for (size_t b = 0; b < bands.size(); ++b) {
+      viz::Series series{r.descriptor, {}, {}};
+      for (int k = 0; k < max_k; ++k) {
+        series.x.push_back(k + 1);
+        series.y.push_back(r.band_curves[b][static_cast<size_t>(k)]);
+      }
+      panels[b].series.push_back(std::move(series));
+    }
     std::printf("%-14s %7.3f %7.3f  %.0f\n", r.descriptor.c_str(), r.top1, r.top16,
                 r.segments_per_second);
     json << "    {\"name\": \"" << r.descriptor << "\", \"top1\": " << r.top1
@@ -86,7 +103,11 @@ int runEvalDescriptors(const std::vector<std::string>& args) {
   json << "  ]\n}\n";
   std::filesystem::create_directories(out);
   writeBytesAtomically(out / "descriptors.json", json.str());
-  std::cout << "wrote " << (out / "descriptors.json").string() << "\n";
+  viz::plotPanels(out / "descriptors.png",
+                  "Descriptor retrieval on " + spec + " (" + std::to_string(q.queries.size()) +
+                      " partial observations of " + std::to_string(q.targets.size()) + " segments)",
+                  panels);
+  std::cout << "wrote " << (out / "descriptors.json").string() << ", descriptors.png\n";
   return 0;
 }
 

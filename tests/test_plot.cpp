@@ -1,0 +1,65 @@
+// The gnuplot wrapper: a PNG with the data beside it, and clear errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/viz/plot.h"
+#include "temp_dir.h"
+
+namespace semsegmap {
+namespace {
+
+using test_support::TempDir;
+
+viz::Panel curvePanel(const std::string& title, double exponent) {
+  viz::Panel p;
+  p.title = title;
+  p.xlabel = "k";
+  p.ylabel = "fraction";
+  p.log_x = true;
+  for (const char* name : {"a", "b's"}) {  // a quote in a name must not break the script
+    viz::Series s{name, {}, {}};
+    for (int k = 1; k <= 50; ++k) {
+      s.x.push_back(k);
+      s.y.push_back(std::pow(k / 50.0, exponent));
+    }
+    p.series.push_back(s);
+    exponent *= 2;
+  }
+  return p;
+}
+
+TEST(Plot, WritesAPngAndItsDataAndScript) {
+  TempDir tmp;
+  const auto png = tmp.path() / "curves.png";
+  viz::plotPanels(png, "two panels", {curvePanel("left", 0.5), curvePanel("right", 1.0)});
+  const std::string bytes = readFileBytes(png);
+  ASSERT_GT(bytes.size(), 8000u);  // two panels of curves, axes and legends
+  EXPECT_EQ(bytes.substr(1, 3), "PNG");
+  // Width: 2 panels of 520 px, from the IHDR chunk (big-endian at byte 16).
+  const auto u8 = [&](size_t i) {
+    return static_cast<uint32_t>(static_cast<unsigned char>(bytes[i]));
+  };
+  EXPECT_EQ((u8(16) << 24) | (u8(17) << 16) | (u8(18) << 8) | u8(19), 1040u);
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() / "curves.png.data" / "plot.gp"));
+  std::ifstream data(tmp.path() / "curves.png.data" / "panel1_series1.dat");
+  std::string header, first;
+  std::getline(data, header);
+  std::getline(data, first);
+  EXPECT_EQ(header, "# b's");
+  EXPECT_EQ(first, "1 0.0004");  // (1/50)^2
+  EXPECT_FALSE(std::filesystem::exists(tmp.path() / "curves.png.tmp"));
+}
+
+TEST(Plot, MismatchedSeriesAndEmptyFiguresAreErrors) {
+  TempDir tmp;
+  viz::Panel bad = curvePanel("bad", 1.0);
+  bad.series[0].y.pop_back();
+  EXPECT_THROW(viz::plotPanels(tmp.path() / "bad.png", "bad", {bad}), std::invalid_argument);
+  EXPECT_THROW(viz::plotPanels(tmp.path() / "none.png", "none", {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace semsegmap
