@@ -70,19 +70,28 @@ void Pipeline::describe(const std::vector<SegmentId>& ids, size_t frame_index) {
   }
 }
 
-std::optional<Localization> Pipeline::query(std::vector<SegmentId>& ids) const {
-  ids.clear();
-  for (const auto& [id, e] : described_) ids.push_back(id);
-  std::sort(ids.begin(), ids.end());  // a deterministic query order
-  std::vector<Eigen::Vector3f> centroids;
-  Eigen::MatrixXf descriptors(static_cast<Eigen::Index>(ids.size()),
-                              ids.empty() ? 0 : described_.at(ids[0]).descriptor.size());
-  for (size_t i = 0; i < ids.size(); ++i) {
-    const DescribedSegment& e = described_.at(ids[i]);
-    centroids.push_back(e.centroid);
-    descriptors.row(static_cast<Eigen::Index>(i)) = e.descriptor.transpose();
+LocalSegmentQuery Pipeline::localSegmentQuery() const {
+  LocalSegmentQuery q;
+  for (const auto& [id, e] : described_) q.ids.push_back(id);
+  std::sort(q.ids.begin(), q.ids.end());
+  q.descriptors.resize(static_cast<Eigen::Index>(q.ids.size()),
+                       q.ids.empty() ? 0 : described_.at(q.ids[0]).descriptor.size());
+  for (size_t i = 0; i < q.ids.size(); ++i) {
+    const DescribedSegment& e = described_.at(q.ids[i]);
+    q.centroids.push_back(e.centroid);
+    q.descriptors.row(static_cast<Eigen::Index>(i)) = e.descriptor.transpose();
   }
-  return localizer_->localize(centroids, descriptors, usable_);
+  return q;
+}
+
+Eigen::VectorXf Pipeline::finalDescriptor(const Segment& s) const {
+  auto it = described_.find(s.id);
+  if (it != described_.end() && it->second.n_points == s.last().n_points)
+    return it->second.descriptor;
+  // Not described in its final state (cannot happen with the segmenter's current rules, but a
+  // finished segment must never leave without its descriptor).
+  const DescriptorInput in{&s.last().points};
+  return describer_->describe({in}).row(0).transpose();
 }
 
 FrameResult Pipeline::process(const Frame& frame) {
@@ -126,22 +135,16 @@ FrameResult Pipeline::process(const Frame& frame) {
   describe(r.segmentation.observed, frame.index);
   r.described = r.segmentation.observed.size();
   for (const Segment& s : r.segmentation.finished) {
-    auto it = described_.find(s.id);
-    if (it == described_.end() || it->second.n_points != s.last().n_points) {
-      // Not described in its final state (cannot happen with the segmenter's current rules, but
-      // a finished segment must never leave without its descriptor).
-      const DescriptorInput in{&s.last().points};
-      r.finished_descriptors.push_back(describer_->describe({in}).row(0).transpose());
-    } else {
-      r.finished_descriptors.push_back(it->second.descriptor);
-    }
+    r.finished_descriptors.push_back(finalDescriptor(s));
     described_.erase(s.id);
   }
   r.times.describe_ms = msSince(t0);
 
   if (localizer_ && (frames_ - 1) % std::max<size_t>(1, config_.localization.every_n_frames) == 0) {
     t0 = std::chrono::steady_clock::now();
-    r.localization = query(r.query_segments);
+    const LocalSegmentQuery q = localSegmentQuery();
+    r.localization = localizer_->localize(q.centroids, q.descriptors, usable_);
+    r.query_segments = q.ids;
     r.times.localize_ms = msSince(t0);
   }
   return r;
@@ -152,15 +155,7 @@ std::vector<Segment> Pipeline::finish(std::vector<Eigen::VectorXf>* descriptors)
   if (descriptors) {
     descriptors->clear();
     if (!describer_) throw std::logic_error("Pipeline::finish: descriptors need a describer");
-    for (const Segment& s : segments) {
-      auto it = described_.find(s.id);
-      if (it != described_.end() && it->second.n_points == s.last().n_points) {
-        descriptors->push_back(it->second.descriptor);
-      } else {
-        const DescriptorInput in{&s.last().points};
-        descriptors->push_back(describer_->describe({in}).row(0).transpose());
-      }
-    }
+    for (const Segment& s : segments) descriptors->push_back(finalDescriptor(s));
   }
   described_.clear();
   return segments;

@@ -51,6 +51,14 @@ struct FrameResult {
   StageTimes times;
 };
 
+// The local segment map as a localization query: ids in ascending order (a deterministic query
+// order), their centroids in the local map frame and one descriptor row each.
+struct LocalSegmentQuery {
+  std::vector<SegmentId> ids;
+  std::vector<Eigen::Vector3f> centroids;
+  Eigen::MatrixXf descriptors;
+};
+
 class Pipeline {
  public:
   // `describer` (optional, not owned) turns segment observations into descriptors.
@@ -72,10 +80,12 @@ class Pipeline {
   const std::unordered_map<SegmentId, DescribedSegment>& localSegments() const {
     return described_;
   }
+  LocalSegmentQuery localSegmentQuery() const;
 
  private:
   void describe(const std::vector<SegmentId>& ids, size_t frame_index);
-  std::optional<Localization> query(std::vector<SegmentId>& ids) const;
+  // The descriptor of a finished segment's final observation.
+  Eigen::VectorXf finalDescriptor(const Segment& s) const;
 
   PipelineConfig config_;
   DatasetInfo info_;

@@ -109,17 +109,8 @@ SlamRun runSlam(FrameSource& source, const PipelineConfig& config, Describer& de
         travelled[i] - last_loop_at >= lc.min_travel_between_loops_m) {
       const TargetMap target = map.targetMap(graph, odom, kind, describer.fingerprint());
       const Localizer localizer(target, config.localization.localizer);
-      std::vector<SegmentId> ids;
-      std::vector<Eigen::Vector3f> centroids;
-      for (const auto& [id, e] : pipeline.localSegments()) ids.push_back(id);
-      std::sort(ids.begin(), ids.end());
-      Eigen::MatrixXf d(static_cast<Eigen::Index>(ids.size()), describer.dimension());
-      for (size_t q = 0; q < ids.size(); ++q) {
-        const DescribedSegment& e = pipeline.localSegments().at(ids[q]);
-        centroids.push_back(e.centroid);
-        d.row(static_cast<Eigen::Index>(q)) = e.descriptor.transpose();
-      }
-      const auto found = localizer.localize(centroids, d, &usable);
+      const LocalSegmentQuery q = pipeline.localSegmentQuery();
+      const auto found = localizer.localize(q.centroids, q.descriptors, &usable);
       if (found) {
         std::vector<size_t> old_nodes;
         for (const auto& m : found->matches) old_nodes.push_back(map.node(m.second));
