@@ -81,6 +81,31 @@ void BM_WholePipeline(benchmark::State& state) {
   state.counters["localize_ms"] = total.localize_ms / n;
   state.counters["Hz"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
 }
+// The front end alone (enrich, local map, segmentation; no describing or querying) on the
+// same frames, to tell the stages' cost apart from their interference in the whole pipeline.
+void BM_PipelineFrontEnd(benchmark::State& state) {
+  const PipelineConfig config =
+      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap.yaml");
+  static Recorded query = s2Frames("sunny", 12);
+  std::unique_ptr<Pipeline> pipeline;
+  size_t i = 0, frames = 0;
+  StageTimes total;
+  for (auto _ : state) {
+    if (!pipeline || i == query.size()) {
+      state.PauseTiming();
+      pipeline = std::make_unique<Pipeline>(config, query.info(), PoseSource::kOdometry);
+      i = 0;
+      state.ResumeTiming();
+    }
+    total += pipeline->process(query.at(i++)).times;
+    ++frames;
+  }
+  const double n = static_cast<double>(std::max<size_t>(1, frames));
+  state.counters["enrich_ms"] = total.enrich_ms / n;
+  state.counters["map_seg_ms"] = (total.local_map_ms + total.segment_ms) / n;
+}
+BENCHMARK(BM_PipelineFrontEnd)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(160);
+
 BENCHMARK(BM_WholePipeline)
     ->Arg(0)
     ->Arg(1)

@@ -95,6 +95,33 @@ TEST(Modes, LocalizationRefusesAMapOfAnotherModel) {
   EXPECT_THROW(runLocalization(*query, semsegmapConfig(), map, oracle), std::invalid_argument);
 }
 
+// The real-data configuration on the ten real KITTI frames (no labels, no poses): the map of the
+// drive localizes the same drive again, with the 7 inliers the paper asks for on real data, at
+// the identity (odometry is the identity without oxts). The descriptors are the shipped model's,
+// trained on simulated data only.
+TEST(Modes, RealDataConfigMapsAndLocalizesTheKittiSample) {
+  const PipelineConfig config =
+      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap-kitti.yaml");
+  EXPECT_EQ(config.localization.localizer.verification.min_inliers, 7);
+  const std::string spec = std::string("kitti-raw:") + SEMSEGMAP_SHARED_DATA +
+                           "/kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
+  // The shipped model: real data has no instance ids for an oracle.
+  const auto describer = makeDescriber(config.descriptor, 1);
+  auto mapping = openDataset(spec);
+  const MappingRun mapped = runMapping(*mapping, config, PoseSource::kOdometry, *describer);
+  ASSERT_GT(mapped.map.size(), 10u);
+  auto query = openDataset(spec);
+  const LocalizationRun run = runLocalization(*query, config, mapped.map, *describer);
+  EXPECT_TRUE(run.trajectory_gt.empty());
+  ASSERT_GE(run.localizations.size(), 3u);
+  for (const LocalizationRecord& r : run.localizations) {
+    EXPECT_GE(r.inliers, 7);
+    // Partly seen segments move their centroids, so the pose is not exact; it is not far off.
+    EXPECT_LT(r.T_map_robot.translation().norm(), 1.5) << "frame " << r.frame_index;
+    EXPECT_LT(Eigen::AngleAxisd(r.T_map_robot.rotation()).angle(), 0.05);
+  }
+}
+
 TEST(Modes, LoopClosureRemovesOdometryDriftOnALoop) {
   PipelineConfig config = semsegmapConfig();
   // The tiny world's block is smaller than the local map: with the default 50 m radius the start

@@ -20,7 +20,7 @@ viz::Panel curvePanel(const std::string& title, double exponent) {
   p.ylabel = "fraction";
   p.log_x = true;
   for (const char* name : {"a", "b's"}) {  // a quote in a name must not break the script
-    viz::Series s{name, {}, {}};
+    viz::Series s{name, {}, {}, {}};
     for (int k = 1; k <= 50; ++k) {
       s.x.push_back(k);
       s.y.push_back(std::pow(k / 50.0, exponent));
@@ -59,6 +59,37 @@ TEST(Plot, MismatchedSeriesAndEmptyFiguresAreErrors) {
   bad.series[0].y.pop_back();
   EXPECT_THROW(viz::plotPanels(tmp.path() / "bad.png", "bad", {bad}), std::invalid_argument);
   EXPECT_THROW(viz::plotPanels(tmp.path() / "none.png", "none", {}), std::invalid_argument);
+}
+
+TEST(Plot, BarsWithLabelsAndStepsAreDrawn) {
+  TempDir tmp;
+  viz::Panel bars;
+  bars.style = viz::PlotStyle::kBars;
+  bars.auto_y = true;
+  for (const char* name : {"x", "y"}) {
+    viz::Series s{name, {0.05, 0.15, 0.25}, {-10, 25, 40}, {"3", "7", "9"}};
+    bars.series.push_back(s);
+  }
+  viz::Panel steps = curvePanel("steps", 1.0);
+  steps.style = viz::PlotStyle::kSteps;
+  const auto png = tmp.path() / "bars.png";
+  viz::plotPanels(png, "bars", {bars, steps});
+  EXPECT_GT(readFileBytes(png).size(), 8000u);
+  const std::string script = readFileBytes(tmp.path() / "bars.png.data" / "plot.gp");
+  // Two series of bars share each bin: slots 0.04 wide (0.8 of 0.1 / 2), at -0.02 and +0.02.
+  EXPECT_NE(script.find("set boxwidth 0.04"), std::string::npos) << script;
+  EXPECT_NE(script.find("($1+-0.020000)"), std::string::npos) << script;
+  EXPECT_NE(script.find("with labels"), std::string::npos);
+  EXPECT_NE(script.find("with steps"), std::string::npos);
+  std::ifstream data(tmp.path() / "bars.png.data" / "panel0_series1.dat");
+  std::string header, first;
+  std::getline(data, header);
+  std::getline(data, first);
+  EXPECT_EQ(first, "0.05 -10 \"3\"");
+
+  viz::Panel bad = bars;
+  bad.series[0].labels.pop_back();
+  EXPECT_THROW(viz::plotPanels(tmp.path() / "bad.png", "bad", {bad}), std::invalid_argument);
 }
 
 }  // namespace

@@ -5,41 +5,15 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "semsegmap/eval/localization_picture.h"
 #include "semsegmap/io/atomic_file.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/open_dataset.h"
 #include "semsegmap/localize/map_file.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/run_output.h"
-#include "semsegmap/viz/localization_png.h"
 
 namespace semsegmap::app {
-
-namespace {
-
-viz::LocalizationPicture pictureOf(const LocalizationRun& run, const TargetMap& map,
-                                   const std::string& title) {
-  viz::LocalizationPicture pic;
-  pic.title = title;
-  for (const MapSegment& s : map.segments) {
-    pic.map_centroids.push_back(s.centroid);
-    pic.map_points.insert(pic.map_points.end(), s.points.begin(), s.points.end());
-  }
-  pic.trajectory = run.trajectory_gt.empty() ? run.trajectory_odom : run.trajectory_gt;
-  const LocalizationRecord* best = nullptr;
-  for (const LocalizationRecord& r : run.localizations) {
-    pic.localizations.emplace_back(r.T_map_robot.translation(),
-                                   r.T_map_robot_gt ? r.translation_error_m : -1.0);
-    if (!best || r.inliers > best->inliers) best = &r;
-  }
-  if (best) {
-    pic.highlight = best->T_map_robot.translation();
-    pic.matches = best->matches;
-  }
-  return pic;
-}
-
-}  // namespace
 
 int runLocalize(const std::vector<std::string>& args) {
   const CliArgs a(args, {"dataset", "config", "map", "out", "max-frames"}, {});
@@ -70,18 +44,20 @@ int runLocalize(const std::vector<std::string>& args) {
   context.map_segments = map.size();
   context.map_bytes = std::filesystem::file_size(map_path);
   writeBytesAtomically(out / "summary.json", localizationSummaryJson(run, context));
-  viz::writeLocalizationPng(
-      out / "localization.png",
-      pictureOf(run, map,
-                source->info().name + " against " + map_path.filename().string() + " (" +
-                    std::filesystem::path(a.require("config")).stem().string() + ")"));
+  writeLocalizationPicture(out / "localization.png", run, map,
+                           source->info().name + " against " + map_path.filename().string() + " (" +
+                               std::filesystem::path(a.require("config")).stem().string() + ")");
 
   const LocalizationSummary s = summarize(run.localizations);
-  std::printf(
-      "frames %zu  localizations %zu  <1 m %zu  <5 m %zu  mean error %.2f m %.2f deg  "
-      "%.1f Hz\n",
-      run.stats.frames, s.localizations, s.below_1m, s.below_5m, s.mean_translation_error_m,
-      s.mean_rotation_error_deg, run.stats.fps());
+  if (run.trajectory_gt.empty())  // errors need ground truth; zeros would read as perfect
+    std::printf("frames %zu  localizations %zu  (no ground truth: errors unknown)  %.1f Hz\n",
+                run.stats.frames, s.localizations, run.stats.fps());
+  else
+    std::printf(
+        "frames %zu  localizations %zu  <1 m %zu  <5 m %zu  mean error %.2f m %.2f deg  "
+        "%.1f Hz\n",
+        run.stats.frames, s.localizations, s.below_1m, s.below_5m, s.mean_translation_error_m,
+        s.mean_rotation_error_deg, run.stats.fps());
   std::cout << "wrote " << (out / "localizations.csv").string()
             << ", summary.json, localization.png\n";
   return 0;

@@ -39,11 +39,23 @@ commands:
                      trains a learned descriptor on simulated ground truth; a key=value after
                      a sim: spec belongs to it, any other item starts a new spec (';' also
                      separates): sim:world=1,run=S1,sim:world=1,run=S1,condition=sunrise
-  eval descriptors   --world-seed N --out DIR [--preset full|small|tiny] [--run S0]
+  eval segmentation  --world-seed N --out DIR [--preset full|small|tiny] [--max-frames K]
+                     [--configs A.yaml,B.yaml] [--segmentation-run S1]
+                     convex hull IoU of segments at revisits, first config against the second
+                     -> segmentation.json, segmentation.png
+  eval descriptors   --world-seed N --out DIR [--preset ...] [--descriptor-run S0]
                      [--max-frames K] [--config FILE] [--models DIR] [--descriptors LIST]
                      rank of each segment's final observation for its earlier ones, per
-                     completeness band, for each descriptor -> DIR/descriptors.json
-  demo               [--out DIR]   the main job on simulated data
+                     completeness band, for each descriptor -> descriptors.json, .png
+  eval localization  --world-seed N --out DIR [--preset ...] [--max-frames K]
+                     [--configs A.yaml,B.yaml] [--map-run S0] [--query-runs S2,S3]
+                     map one run, localize the others with every config -> localization.json,
+                     localization_accuracy.png, maps/, one folder per run and config
+  eval paper         --world-seed N --out DIR [all of the above]
+                     the three experiments and report.md
+  demo               [--out DIR] [--world-seed N] [--preset small] [--max-frames K]
+                     the main job: map S0, localize S2 and S3 with SemSegMap and SegMap on
+                     the small world -> table, report.md and pictures in DIR
 
 datasets (SPEC): DIR (project format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,
                  sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small]

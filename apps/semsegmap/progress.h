@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 namespace semsegmap::app {
@@ -38,6 +39,22 @@ class Progress {
   size_t total_;
   std::chrono::steady_clock::time_point start_;
   double last_ = -1.0;
+};
+
+// One bar per stage of a longer job (an ExperimentProgress): a new bar when the stage changes.
+class StageProgress {
+ public:
+  void operator()(const std::string& stage, size_t done, size_t total) {
+    if (!bar_ || stage != stage_) {
+      stage_ = stage;
+      bar_ = std::make_unique<Progress>(stage, total);
+    }
+    bar_->update(done, total);
+  }
+
+ private:
+  std::string stage_;
+  std::unique_ptr<Progress> bar_;
 };
 
 }  // namespace semsegmap::app

@@ -33,83 +33,109 @@ std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int thr
   return makeDescriber(parseDescriptorKind(config.kind), options);
 }
 
-MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
-                      Describer& describer, const RunOptions& options) {
-  Pipeline pipeline(config, source.info(), poses, &describer);
-  TargetMapBuilder builder(descriptorName(describer.kind()), describer.fingerprint(),
-                           describer.dimension(), config.target_map);
-  MappingRun run;
-  const size_t points = config.target_map.max_points_per_segment;
-  auto add = [&](const std::vector<Segment>& segments, const std::vector<Eigen::VectorXf>& d) {
-    for (size_t i = 0; i < segments.size(); ++i)
-      builder.add(mapSegmentOf(segments[i], points), d[i]);
-    run.segments += segments.size();
-  };
-  const size_t n = framesToRun(source, options);
-  for (size_t i = 0; i < n; ++i) {
-    const FrameResult r = pipeline.process(source.frame(i));
-    run.trajectory.push_back(r.T_map_base);
-    add(r.segmentation.finished, r.finished_descriptors);
-    run.stats.total += r.times;
-    ++run.stats.frames;
-    if (options.progress) options.progress(i + 1, n);
-  }
-  std::vector<Eigen::VectorXf> last;
-  const std::vector<Segment> remaining = pipeline.finish(&last);
-  add(remaining, last);
-  run.map = builder.build();
-  run.duplicates_removed = builder.duplicatesRemoved();
-  return run;
+MappingSession::MappingSession(const PipelineConfig& config, const DatasetInfo& info,
+                               PoseSource poses, Describer& describer)
+    : config_(config),
+      pipeline_(config, info, poses, &describer),
+      builder_(descriptorName(describer.kind()), describer.fingerprint(), describer.dimension(),
+               config.target_map) {}
+
+void MappingSession::add(const std::vector<Segment>& segments,
+                         const std::vector<Eigen::VectorXf>& d) {
+  for (size_t i = 0; i < segments.size(); ++i)
+    builder_.add(mapSegmentOf(segments[i], config_.target_map.max_points_per_segment), d[i]);
+  run_.segments += segments.size();
 }
 
-LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
-                                const TargetMap& map, Describer& describer,
-                                const RunOptions& options) {
+void MappingSession::process(const Frame& frame) {
+  const FrameResult r = pipeline_.process(frame);
+  run_.trajectory.push_back(r.T_map_base);
+  add(r.segmentation.finished, r.finished_descriptors);
+  run_.stats.total += r.times;
+  ++run_.stats.frames;
+}
+
+MappingRun MappingSession::finish() {
+  std::vector<Eigen::VectorXf> last;
+  const std::vector<Segment> remaining = pipeline_.finish(&last);
+  add(remaining, last);
+  run_.map = builder_.build();
+  run_.duplicates_removed = builder_.duplicatesRemoved();
+  return std::move(run_);
+}
+
+MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
+                      Describer& describer, const RunOptions& options) {
+  MappingSession session(config, source.info(), poses, describer);
+  const size_t n = framesToRun(source, options);
+  for (size_t i = 0; i < n; ++i) {
+    session.process(source.frame(i));
+    if (options.progress) options.progress(i + 1, n);
+  }
+  return session.finish();
+}
+
+namespace {
+const TargetMap& checkedMap(const TargetMap& map, const Describer& describer) {
   if (map.descriptor != descriptorName(describer.kind()) ||
       map.fingerprint != describer.fingerprint() || map.dimension() != describer.dimension())
     throw std::invalid_argument("the target map's descriptors (" + map.descriptor + " " +
                                 map.fingerprint + ") do not match the describer's (" +
                                 descriptorName(describer.kind()) + " " + describer.fingerprint() +
                                 ")");
-  const Localizer localizer(map, config.localization.localizer);
-  Pipeline pipeline(config, source.info(), PoseSource::kOdometry, &describer);
-  pipeline.setLocalizer(&localizer);
-  LocalizationRun run;
+  return map;
+}
+}  // namespace
+
+LocalizationSession::LocalizationSession(const PipelineConfig& config, const DatasetInfo& info,
+                                         const TargetMap& map, Describer& describer)
+    : map_(checkedMap(map, describer)),
+      localizer_(map, config.localization.localizer),
+      pipeline_(config, info, PoseSource::kOdometry, &describer) {
+  pipeline_.setLocalizer(&localizer_);
+}
+
+void LocalizationSession::process(const Frame& frame) {
+  const FrameResult r = pipeline_.process(frame);
+  if (!run_.trajectory_odom.empty())
+    run_.distance_m +=
+        (r.T_map_base.translation() - run_.trajectory_odom.back().translation()).norm();
+  run_.trajectory_odom.push_back(r.T_map_base);
+  if (frame.T_world_base_gt) run_.trajectory_gt.push_back(*frame.T_world_base_gt);
+  run_.stats.total += r.times;
+  ++run_.stats.frames;
+  if (!r.localization) return;
+  const Localization& l = *r.localization;
+  LocalizationRecord rec;
+  rec.frame_index = frame.index;
+  rec.timestamp_s = frame.timestamp_s;
+  rec.T_map_robot = l.T_map_local * r.T_map_base;
+  rec.inliers = l.inliers;
+  rec.candidates = l.candidates;
+  if (frame.T_world_base_gt) {
+    rec.T_map_robot_gt = *frame.T_world_base_gt;
+    rec.translation_error_m = translationError(rec.T_map_robot, *frame.T_world_base_gt);
+    rec.rotation_error_deg = rotationErrorDeg(rec.T_map_robot, *frame.T_world_base_gt);
+  }
+  const auto& local = pipeline_.localSegments();
+  for (const auto& [q, t] : l.matches) {
+    const Eigen::Vector3f c = local.at(r.query_segments.at(q)).centroid;
+    rec.matches.emplace_back((l.T_map_local * c.cast<double>()).cast<float>(),
+                             map_.segments.at(t).centroid);
+  }
+  run_.localizations.push_back(std::move(rec));
+}
+
+LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
+                                const TargetMap& map, Describer& describer,
+                                const RunOptions& options) {
+  LocalizationSession session(config, source.info(), map, describer);
   const size_t n = framesToRun(source, options);
   for (size_t i = 0; i < n; ++i) {
-    const Frame frame = source.frame(i);
-    const FrameResult r = pipeline.process(frame);
-    if (!run.trajectory_odom.empty())
-      run.distance_m +=
-          (r.T_map_base.translation() - run.trajectory_odom.back().translation()).norm();
-    run.trajectory_odom.push_back(r.T_map_base);
-    if (frame.T_world_base_gt) run.trajectory_gt.push_back(*frame.T_world_base_gt);
-    run.stats.total += r.times;
-    ++run.stats.frames;
-    if (r.localization) {
-      const Localization& l = *r.localization;
-      LocalizationRecord rec;
-      rec.frame_index = frame.index;
-      rec.timestamp_s = frame.timestamp_s;
-      rec.T_map_robot = l.T_map_local * r.T_map_base;
-      rec.inliers = l.inliers;
-      rec.candidates = l.candidates;
-      if (frame.T_world_base_gt) {
-        rec.T_map_robot_gt = *frame.T_world_base_gt;
-        rec.translation_error_m = translationError(rec.T_map_robot, *frame.T_world_base_gt);
-        rec.rotation_error_deg = rotationErrorDeg(rec.T_map_robot, *frame.T_world_base_gt);
-      }
-      const auto& local = pipeline.localSegments();
-      for (const auto& [q, t] : l.matches) {
-        const Eigen::Vector3f c = local.at(r.query_segments.at(q)).centroid;
-        rec.matches.emplace_back((l.T_map_local * c.cast<double>()).cast<float>(),
-                                 map.segments.at(t).centroid);
-      }
-      run.localizations.push_back(std::move(rec));
-    }
+    session.process(source.frame(i));
     if (options.progress) options.progress(i + 1, n);
   }
-  return run;
+  return session.take();
 }
 
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {

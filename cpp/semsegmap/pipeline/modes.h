@@ -34,8 +34,24 @@ struct MappingRun {
   RunStats stats;
 };
 
-// Maps the run with poses from ground truth or odometry (for the loop-closed trajectory, see
-// runSlam). Keeps config.target_map.max_points_per_segment picture points per segment.
+// Maps a run frame by frame, with poses from ground truth or odometry (for the loop-closed
+// trajectory, see runSlam). Keeps config.target_map.max_points_per_segment picture points per
+// segment. Frame by frame so that several configurations can share one rendered frame.
+class MappingSession {
+ public:
+  MappingSession(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
+                 Describer& describer);
+  void process(const Frame& frame);
+  MappingRun finish();  // once, after the last frame
+
+ private:
+  void add(const std::vector<Segment>& segments, const std::vector<Eigen::VectorXf>& d);
+  PipelineConfig config_;
+  Pipeline pipeline_;
+  TargetMapBuilder builder_;
+  MappingRun run_;
+};
+
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
                       Describer& describer, const RunOptions& options = {});
 
@@ -60,7 +76,25 @@ struct LocalizationRun {
 };
 
 // Localizes every frame's local segment map (built on odometry, as a robot would) against
-// `map`; checks the describer against the map first (kind, dimension and model).
+// `map`; checks the describer against the map first (kind, dimension and model). `map` must
+// outlive the session.
+class LocalizationSession {
+ public:
+  LocalizationSession(const PipelineConfig& config, const DatasetInfo& info, const TargetMap& map,
+                      Describer& describer);
+  LocalizationSession(const LocalizationSession&) = delete;  // the pipeline points at localizer_
+  LocalizationSession& operator=(const LocalizationSession&) = delete;
+  void process(const Frame& frame);
+  const LocalizationRun& run() const { return run_; }
+  LocalizationRun take() { return std::move(run_); }
+
+ private:
+  const TargetMap& map_;
+  Localizer localizer_;
+  Pipeline pipeline_;
+  LocalizationRun run_;
+};
+
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
                                 const TargetMap& map, Describer& describer,
                                 const RunOptions& options = {});

@@ -5,21 +5,9 @@
 #include <sstream>
 
 #include "semsegmap/io/atomic_file.h"
+#include "semsegmap/io/json.h"
 
 namespace semsegmap {
-
-namespace {
-
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
-}  // namespace
 
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
@@ -47,8 +35,9 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   const StageTimes& t = run.stats.total;
   const double n = std::max<double>(1.0, static_cast<double>(run.stats.frames));
   std::ostringstream j;
-  j << "{\n  \"dataset\": " << quoted(c.dataset) << ",\n  \"map\": " << quoted(c.map)
-    << ",\n  \"config\": " << quoted(c.config) << ",\n  \"descriptor\": " << quoted(c.descriptor)
+  j << "{\n  \"dataset\": " << jsonQuoted(c.dataset) << ",\n  \"map\": " << jsonQuoted(c.map)
+    << ",\n  \"config\": " << jsonQuoted(c.config)
+    << ",\n  \"descriptor\": " << jsonQuoted(c.descriptor)
     << ",\n  \"frames\": " << run.stats.frames << ",\n  \"distance_m\": " << run.distance_m
     << ",\n  \"has_ground_truth\": " << (run.trajectory_gt.empty() ? "false" : "true")
     << ",\n  \"n_localizations\": " << s.localizations

@@ -69,8 +69,8 @@ SegmentationUpdate IncrementalSegmenter::update(const LocalMap& map, const Local
     e.attributes.hue = v->hue();
     e.attributes.has_color = v->n_colored > 0;
     e.attributes.class_id = v->semanticClass();
-    voxels_.emplace(key, e);
-    cells_[cellOf(e.attributes.position)].push_back({key, e.attributes});
+    VoxelEntry* entry = &voxels_.emplace(key, e).first->second;
+    cells_[cellOf(e.attributes.position)].push_back({key, e.attributes, entry});
     seeds.push_back(key);
   }
 
@@ -100,8 +100,9 @@ SegmentationUpdate IncrementalSegmenter::update(const LocalMap& map, const Local
             auto cell = cells_.find(packVoxelKey(c + Eigen::Vector3i(dx, dy, dz)));
             if (cell == cells_.end()) continue;
             for (const CellEntry& n : cell->second) {
-              if (n.key == u || !distance_.connected(a, n.attributes)) continue;
-              VoxelEntry& e = voxels_.at(n.key);
+              VoxelEntry& e = *n.entry;
+              // Already in this region (or queued): nothing to learn from the distance.
+              if (e.segment == kGrowing || !distance_.connected(a, n.attributes)) continue;
               if (e.segment >= 0) {
                 if (std::find(touched.begin(), touched.end(), e.segment) == touched.end())
                   touched.push_back(e.segment);

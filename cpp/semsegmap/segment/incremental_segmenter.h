@@ -57,6 +57,9 @@ class IncrementalSegmenter {
   struct CellEntry {
     VoxelKey key;
     DistanceVoxel attributes;
+    // The voxel's entry in voxels_ (unordered_map nodes never move), so that region growing
+    // reads a neighbour's segment without a hash lookup; erased before the entry is.
+    VoxelEntry* entry;
   };
 
   uint64_t cellOf(const Eigen::Vector3f& p) const;

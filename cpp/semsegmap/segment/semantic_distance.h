@@ -40,8 +40,11 @@ class SemanticDistance {
   // A voxel without colour or of unknown class carries no evidence for a penalty: only what two
   // voxels both know can keep them apart.
   float squared(const DistanceVoxel& a, const DistanceVoxel& b) const;
+  // Region growing asks this for every neighbour of every new voxel: inline, and most pairs are
+  // decided by their positions alone.
   bool connected(const DistanceVoxel& a, const DistanceVoxel& b) const {
-    return squared(a, b) <= d2_;
+    const float d2 = (a.position - b.position).squaredNorm();
+    return d2 <= d2_ && squared(a, b) <= d2_;
   }
 
  private:

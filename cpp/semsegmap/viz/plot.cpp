@@ -1,5 +1,7 @@
 #include "semsegmap/viz/plot.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -21,6 +23,14 @@ std::string quoted(const std::string& s) {
   return out + "'";
 }
 
+// Bars of several series share each x: each gets a slot of the spacing between x values.
+double barWidth(const Panel& panel) {
+  double spacing = 1.0;
+  for (const Series& s : panel.series)
+    if (s.x.size() >= 2) spacing = std::abs(s.x[1] - s.x[0]);
+  return 0.8 * spacing / static_cast<double>(std::max<size_t>(1, panel.series.size()));
+}
+
 }  // namespace
 
 void plotPanels(const std::filesystem::path& png, const std::string& title,
@@ -37,9 +47,32 @@ void plotPanels(const std::filesystem::path& png, const std::string& title,
   for (size_t p = 0; p < panels.size(); ++p) {
     const Panel& panel = panels[p];
     gp << "set title " << quoted(panel.title) << "\nset xlabel " << quoted(panel.xlabel)
-       << "\nset ylabel " << quoted(panel.ylabel) << "\nset yrange [" << panel.y_min << ":"
-       << panel.y_max << "]\n"
-       << (panel.log_x ? "set logscale x\n" : "unset logscale x\n") << "plot ";
+       << "\nset ylabel " << quoted(panel.ylabel) << "\n";
+    if (panel.auto_y)
+      gp << "set autoscale y\n";
+    else
+      gp << "set yrange [" << panel.y_min << ":" << panel.y_max << "]\n";
+    gp << (panel.log_x ? "set logscale x\n" : "unset logscale x\n");
+    const double bar = barWidth(panel);
+    if (panel.style == PlotStyle::kBars) {
+      // The x range spans the bins exactly; autoscaled y gets headroom for the labels.
+      double lo = 0, hi = 0;
+      bool any = false;
+      for (const Series& s : panel.series)
+        for (double x : s.x) {
+          lo = any ? std::min(lo, x) : x;
+          hi = any ? std::max(hi, x) : x;
+          any = true;
+        }
+      const double half =
+          0.5 * bar * static_cast<double>(std::max<size_t>(1, panel.series.size())) / 0.8;
+      gp << "set boxwidth " << bar << " absolute\nset style fill solid 0.75 border -1\n"
+         << "set xzeroaxis lt -1\nset key top right\nset offsets 0, 0, graph 0.1, graph 0.05\n";
+      if (any) gp << "set xrange [" << lo - half << ":" << hi + half << "]\n";
+    } else {
+      gp << "unset xzeroaxis\nset key bottom right\nset offsets 0, 0, 0, 0\nset autoscale x\n";
+    }
+    gp << "plot ";
     for (size_t s = 0; s < panel.series.size(); ++s) {
       const Series& series = panel.series[s];
       if (series.x.size() != series.y.size())
@@ -47,13 +80,32 @@ void plotPanels(const std::filesystem::path& png, const std::string& title,
                                     "' has different numbers of x and y values");
       const std::filesystem::path data =
           dir / ("panel" + std::to_string(p) + "_series" + std::to_string(s) + ".dat");
+      if (!series.labels.empty() && series.labels.size() != series.x.size())
+        throw std::invalid_argument(png.string() + ": series '" + series.name +
+                                    "' has a label count that differs from its points");
+      // Bars of series s sit at their slot beside x; the data file keeps the true x.
+      const double shift =
+          panel.style == PlotStyle::kBars
+              ? (static_cast<double>(s) - 0.5 * static_cast<double>(panel.series.size() - 1)) * bar
+              : 0.0;
       writeFileAtomically(data, [&](std::ostream& out) {
         out << "# " << series.name << "\n";
-        for (size_t i = 0; i < series.x.size(); ++i)
-          out << series.x[i] << ' ' << series.y[i] << '\n';
+        for (size_t i = 0; i < series.x.size(); ++i) {
+          out << series.x[i] << ' ' << series.y[i];
+          if (!series.labels.empty()) out << " \"" << series.labels[i] << '"';
+          out << '\n';
+        }
       });
-      gp << (s ? ", " : "") << quoted(data.string()) << " using 1:2 with lines lw 2 title "
-         << quoted(series.name);
+      const std::string x = "($1+" + std::to_string(shift) + ")";
+      const char* style = panel.style == PlotStyle::kBars    ? "boxes"
+                          : panel.style == PlotStyle::kSteps ? "steps lw 2"
+                                                             : "lines lw 2";
+      gp << (s ? ", " : "") << quoted(data.string()) << " using " << x << ":2 with " << style
+         << " title " << quoted(series.name);
+      if (!series.labels.empty())
+        // Above the bar, or above the zero line for a negative one.
+        gp << ", " << quoted(data.string()) << " using " << x
+           << ":($2 > 0 ? $2 : 0):3 with labels offset 0,0.6 font ',8' notitle";
     }
     gp << "\n";
   }

@@ -14,12 +14,21 @@ namespace semsegmap::viz {
 struct Series {
   std::string name;
   std::vector<double> x, y;
+  std::vector<std::string> labels;  // optional, one per point: printed above it (bars)
+};
+
+enum class PlotStyle {
+  kLines,
+  kSteps,  // cumulative counts: a step at every value
+  kBars,   // histograms: the series side by side at each x (equally spaced x)
 };
 
 struct Panel {
   std::string title, xlabel, ylabel;
   std::vector<Series> series;
+  PlotStyle style = PlotStyle::kLines;
   bool log_x = false;
+  bool auto_y = false;  // gnuplot picks the y range instead of [y_min, y_max]
   double y_min = 0.0, y_max = 1.0;
 };
 

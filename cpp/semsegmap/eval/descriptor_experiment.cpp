@@ -1,0 +1,115 @@
+#include "semsegmap/eval/descriptor_experiment.h"
+
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/io/json.h"
+#include "semsegmap/viz/plot.h"
+
+namespace semsegmap {
+
+DescriptorExperiment runDescriptorExperiment(const DescriptorExperimentConfig& cfg,
+                                             const std::filesystem::path& out,
+                                             const ExperimentProgress& progress) {
+  DescriptorExperiment e;
+  e.config = cfg;
+  e.dataset = simulatedRunSpec(cfg.world_seed, cfg.run, cfg.preset);
+  DescriberOptions options;
+  options.threads = cfg.threads;
+  // Load every model first: a missing one should fail before minutes of simulation.
+  std::vector<std::unique_ptr<Describer>> describers;
+  for (const std::string& name : cfg.descriptors) {
+    options.model_path = (cfg.models / (name + ".model")).string();
+    describers.push_back(makeDescriber(parseDescriptorKind(name), options));
+  }
+
+  ExtractionConfig extraction;
+  extraction.max_frames = cfg.max_frames;
+  extraction.min_purity = 0.0f;  // every segment counts, as it would in a target map
+  const TrainingSet set = extractTrainingSet({e.dataset}, cfg.segmentation.config, extraction,
+                                             [&](size_t done, size_t total, size_t) {
+                                               if (progress)
+                                                 progress("segment " + cfg.run, done, total);
+                                             });
+  const RetrievalQueries q = makeRetrievalQueries(set);
+  e.segments = q.targets.size();
+  e.queries = q.queries.size();
+  e.bands = defaultCompletenessBands();
+
+  std::ostringstream json;
+  json << "{\n  \"dataset\": " << jsonQuoted(e.dataset) << ",\n  \"segments\": " << e.segments
+       << ",\n  \"queries\": " << e.queries << ",\n  \"bands\": [";
+  for (size_t b = 0; b < e.bands.size(); ++b)
+    json << (b ? ", " : "") << jsonQuoted(e.bands[b].name);
+  json << "],\n  \"descriptors\": [\n";
+  // One panel per completeness band, one curve per descriptor: the paper's retrieval figure.
+  std::vector<viz::Panel> panels(e.bands.size());
+  for (size_t b = 0; b < e.bands.size(); ++b) {
+    panels[b].title = "completeness " + e.bands[b].name;
+    panels[b].xlabel = "k (nearest target descriptors)";
+    panels[b].ylabel = "fraction of true matches within k";
+    panels[b].log_x = true;
+  }
+  for (size_t d = 0; d < describers.size(); ++d) {
+    if (progress) progress("describe", d, describers.size());
+    DescriptorRetrieval r = evaluateRetrieval(*describers[d], set, q, e.bands, cfg.max_k);
+    for (size_t b = 0; b < e.bands.size(); ++b) {
+      viz::Series series;
+      series.name = r.descriptor;
+      for (int k = 0; k < cfg.max_k; ++k) {
+        series.x.push_back(k + 1);
+        series.y.push_back(r.band_curves[b][static_cast<size_t>(k)]);
+      }
+      panels[b].series.push_back(std::move(series));
+    }
+    json << "    {\"name\": " << jsonQuoted(r.descriptor) << ", \"top1\": " << r.top1
+         << ", \"top16\": " << r.top16 << ", \"segments_per_second\": " << r.segments_per_second
+         << ", \"band_counts\": [";
+    for (size_t b = 0; b < e.bands.size(); ++b) json << (b ? ", " : "") << r.band_counts[b];
+    json << "], \"band_curves\": [";
+    for (size_t b = 0; b < e.bands.size(); ++b) {
+      json << (b ? ", " : "") << "[";
+      for (int k = 0; k < cfg.max_k; ++k) json << (k ? ", " : "") << r.band_curves[b][k];
+      json << "]";
+    }
+    json << "]}" << (d + 1 < describers.size() ? "," : "") << "\n";
+    e.results.push_back(std::move(r));
+  }
+  if (progress) progress("describe", describers.size(), describers.size());
+  json << "  ]\n}\n";
+  std::filesystem::create_directories(out);
+  writeBytesAtomically(out / "descriptors.json", json.str());
+  viz::plotPanels(out / "descriptors.png",
+                  "Descriptor retrieval on " + e.dataset + " (" + std::to_string(e.queries) +
+                      " partial observations of " + std::to_string(e.segments) + " segments)",
+                  panels);
+  return e;
+}
+
+std::string descriptorTable(const DescriptorExperiment& e) {
+  std::ostringstream t;
+  t << "| descriptor | top-1 | top-16 |";
+  for (const CompletenessBand& b : e.bands) t << " top-16 " << b.name << " |";
+  t << " segments/s |\n| --- | ---: | ---: |";
+  for (size_t b = 0; b < e.bands.size(); ++b) t << " ---: |";
+  t << " ---: |\n";
+  char v[64];
+  for (const DescriptorRetrieval& r : e.results) {
+    std::snprintf(v, sizeof(v), "| %s | %.3f | %.3f |", r.descriptor.c_str(), r.top1, r.top16);
+    t << v;
+    for (size_t b = 0; b < e.bands.size(); ++b) {
+      // The curve's 16th entry: within k = 16 (or the last k asked for).
+      const auto& curve = r.band_curves[b];
+      const double top16 = curve.empty() ? 0.0 : curve[std::min<size_t>(15, curve.size() - 1)];
+      std::snprintf(v, sizeof(v), " %.3f |", top16);
+      t << v;
+    }
+    std::snprintf(v, sizeof(v), " %.0f |\n", r.segments_per_second);
+    t << v;
+  }
+  return t.str();
+}
+
+}  // namespace semsegmap

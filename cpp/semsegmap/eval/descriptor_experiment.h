@@ -1,0 +1,42 @@
+// The descriptor-retrieval experiment (paper section IV-C) as one call: segment a simulated run,
+// describe every observation with each descriptor, and rank each partial observation's segment
+// among the final observations of all segments (eval/descriptor_eval.h).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "semsegmap/eval/descriptor_eval.h"
+#include "semsegmap/eval/experiment.h"
+
+namespace semsegmap {
+
+struct DescriptorExperimentConfig {
+  uint64_t world_seed = 1;
+  std::string preset = "full";
+  std::string run = "S0";
+  size_t max_frames = 0;
+  NamedConfig segmentation;  // how the run is cut into segments
+  std::filesystem::path models = "models";
+  std::vector<std::string> descriptors = {"semsegmap-net", "segmap-cnn", "fpfh", "eigen"};
+  int threads = 0;
+  int max_k = 50;
+};
+
+struct DescriptorExperiment {
+  DescriptorExperimentConfig config;
+  std::string dataset;
+  size_t segments = 0, queries = 0;
+  std::vector<CompletenessBand> bands;
+  std::vector<DescriptorRetrieval> results;
+};
+
+// Writes descriptors.json and descriptors.png (one panel per completeness band) into `out`.
+DescriptorExperiment runDescriptorExperiment(const DescriptorExperimentConfig& config,
+                                             const std::filesystem::path& out,
+                                             const ExperimentProgress& progress = {});
+
+std::string descriptorTable(const DescriptorExperiment& e);  // Markdown: top-1, top-16 per band
+
+}  // namespace semsegmap

@@ -1,0 +1,28 @@
+// What the paper's experiments (eval/*_experiment.h) share: the configurations they compare,
+// named after their files, the simulated runs they read, and how they report progress.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "semsegmap/pipeline/pipeline_config.h"
+
+namespace semsegmap {
+
+struct NamedConfig {
+  std::string name;  // the file's stem: "semsegmap", "segmap"
+  std::filesystem::path path;
+  PipelineConfig config;
+};
+NamedConfig loadNamedConfig(const std::filesystem::path& path);
+
+// "sim:world=N,run=R,preset=P[,frames=F]": the dataset spec of a simulated run.
+std::string simulatedRunSpec(uint64_t world_seed, const std::string& run, const std::string& preset,
+                             size_t max_frames = 0);
+
+// Called as work advances: a stage name (e.g. "map S0") and how far it is.
+using ExperimentProgress = std::function<void(const std::string& stage, size_t done, size_t total)>;
+
+}  // namespace semsegmap

@@ -1,0 +1,63 @@
+// The localization experiment (paper section IV-D, Table I): map one simulated run, localize
+// other runs of the same world against the map, every configuration on the very same frames
+// (each frame is rendered once and fed to every configuration's pipeline).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "semsegmap/eval/experiment.h"
+#include "semsegmap/pipeline/modes.h"
+
+namespace semsegmap {
+
+struct LocalizationExperimentConfig {
+  uint64_t world_seed = 1;
+  std::string preset = "full";  // sim::worldPreset
+  std::string map_run = "S0";
+  std::vector<std::string> query_runs = {"S2", "S3"};
+  size_t max_frames = 0;             // per run; 0: all
+  std::vector<NamedConfig> configs;  // compared side by side (semsegmap, segmap)
+  double correct_m = 1.0;            // a localization this close counts for recall
+  double wrong_m = 5.0;              // a localization farther off is wrong
+  double recall_window_m = 20.0;
+  size_t picture_points_per_segment = 32;  // kept in memory for the pictures, not saved
+};
+
+struct LocalizationResult {  // one configuration on one query run
+  std::string config, descriptor, fingerprint, run, dataset;
+  size_t frames = 0;
+  double distance_m = 0.0;
+  LocalizationSummary summary;
+  size_t wrong = 0;         // error > wrong_m
+  double wrong_rate = 0.0;  // wrong / localizations
+  double recall = 0.0;      // along the trajectory, see eval/localization_metrics.h
+  double hz = 0.0;          // the whole pipeline
+  StageTimes per_frame;     // mean stage times
+  size_t map_segments = 0;
+  uint64_t map_bytes = 0;
+  std::vector<double> errors;  // translation error of each localization, m
+  std::filesystem::path dir;   // its files, relative to the output directory
+};
+
+struct LocalizationExperiment {
+  LocalizationExperimentConfig config;
+  std::vector<LocalizationResult> results;  // query run major, then configuration
+  std::vector<double> thresholds;           // of the cumulative curves, m
+};
+
+// Writes into `out`: maps/<config>.map, <config>_<run>/ (localizations.csv, summary.json,
+// localization.png), localization.json with every number, and localization_accuracy.png (the
+// cumulative number of localizations against the error threshold, one panel per query run).
+LocalizationExperiment runLocalizationExperiment(const LocalizationExperimentConfig& config,
+                                                 const std::filesystem::path& out,
+                                                 const ExperimentProgress& progress = {});
+
+// The results as a Markdown table (one row per run and configuration).
+std::string localizationTable(const LocalizationExperiment& e);
+
+// The paper's Table I localizations (SegMap, SemSegMap) for a simulated run; {-1, -1} if none.
+std::pair<int, int> paperLocalizations(const std::string& run);
+
+}  // namespace semsegmap

@@ -1,0 +1,152 @@
+// The paper's experiments (eval/*_experiment.h): their metrics on known numbers, and each one end
+// to end on the tiny world with its JSON read back (yaml-cpp reads JSON) and its pictures present.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+
+#include "semsegmap/eval/localization_metrics.h"
+#include "semsegmap/eval/report.h"
+#include "semsegmap/io/atomic_file.h"
+#include "temp_dir.h"
+
+namespace semsegmap {
+namespace {
+
+using test_support::TempDir;
+
+const std::string kSource = SEMSEGMAP_SOURCE_DIR;
+
+std::vector<NamedConfig> bothConfigs() {
+  return {loadNamedConfig(kSource + "/config/semsegmap.yaml"),
+          loadNamedConfig(kSource + "/config/segmap.yaml")};
+}
+
+void expectPng(const std::filesystem::path& path) {
+  ASSERT_TRUE(std::filesystem::exists(path)) << path;
+  EXPECT_EQ(readFileBytes(path).substr(1, 3), "PNG") << path;
+}
+
+TEST(LocalizationMetrics, CumulativeCountsOfAKnownErrorList) {
+  const std::vector<double> errors = {0.2, 0.9, 0.2, 3.0, 12.0};
+  EXPECT_EQ(cumulativeCounts(errors, {0.0, 0.2, 0.5, 1.0, 5.0, 100.0}),
+            (std::vector<size_t>{0, 2, 2, 3, 4, 5}));
+  EXPECT_TRUE(cumulativeCounts({}, {1.0}) == std::vector<size_t>{0});
+}
+
+TEST(LocalizationMetrics, RecallAlongTheTrajectory) {
+  // 11 frames 10 m apart (100 m). A correct fix at frame 2 (20 m) covers the metres up to 40 m;
+  // one at frame 7 (70 m) those up to 90 m: 20 + 20 of 100 m.
+  std::vector<double> travelled;
+  for (int i = 0; i <= 10; ++i) travelled.push_back(10.0 * i);
+  EXPECT_NEAR(recallAlongTrajectory(travelled, {2, 7}, 20.0), 0.4, 1e-12);
+  EXPECT_NEAR(recallAlongTrajectory(travelled, {7, 2, 2}, 20.0), 0.4, 1e-12);  // any order
+  EXPECT_NEAR(recallAlongTrajectory(travelled, {}, 20.0), 0.0, 1e-12);
+  std::vector<size_t> all(11);
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  EXPECT_NEAR(recallAlongTrajectory(travelled, all, 20.0), 1.0, 1e-12);
+  EXPECT_EQ(recallAlongTrajectory({0.0}, {0}, 20.0), 0.0);  // no drive
+  EXPECT_THROW(recallAlongTrajectory(travelled, {11}, 20.0), std::out_of_range);
+  const std::vector<Pose> line = {planarPose(0, 0, 0, 0), planarPose(3, 4, 0, 1),
+                                  planarPose(3, 4, 0, 2)};
+  EXPECT_EQ(travelledDistances(line), (std::vector<double>{0.0, 5.0, 5.0}));
+}
+
+TEST(SegmentationExperiment, HistogramAndRelativeChange) {
+  EXPECT_EQ(iouHistogram({0.0, 0.05, 0.1, 0.33, 0.99, 1.0}, 10),
+            (std::vector<size_t>{2, 1, 0, 1, 0, 0, 0, 0, 0, 2}));
+  EXPECT_THROW(iouHistogram({0.5}, 0), std::invalid_argument);
+  EXPECT_DOUBLE_EQ(relativeChangePct(131, 100), 31.0);
+  EXPECT_DOUBLE_EQ(relativeChangePct(75, 100), -25.0);
+  EXPECT_DOUBLE_EQ(relativeChangePct(5, 0), 0.0);
+}
+
+// All three experiments on the tiny world (a few frames each), then the report that links them.
+TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
+  TempDir tmp;
+  const std::filesystem::path out = tmp.path();
+
+  SegmentationExperimentConfig sc;
+  sc.preset = "tiny";
+  sc.max_frames = 400;  // the tiny S1 is back where it started after about 300 m
+  sc.exclude_recent_m = 40.0;
+  sc.configs = bothConfigs();
+  const SegmentationExperiment s = runSegmentationExperiment(sc, out);
+  const YAML::Node sj = YAML::LoadFile((out / "segmentation.json").string());
+  ASSERT_EQ(sj["results"].size(), 2u);
+  for (const auto& r : sj["results"]) {
+    const size_t revisits = r["revisit_segments"].as<size_t>();
+    EXPECT_GT(revisits, 0u) << r["config"].as<std::string>();
+    EXPECT_EQ(r["consistent"].as<size_t>() + r["inconsistent"].as<size_t>(), revisits);
+    size_t sum = 0;
+    for (const auto& v : r["histogram"]) sum += v.as<size_t>();
+    EXPECT_EQ(sum, revisits);
+    EXPECT_GE(r["segments"].as<size_t>(), revisits);
+  }
+  EXPECT_EQ(sj["bin_change_pct"].size(), 10u);
+  EXPECT_NEAR(sj["consistent_change_pct"].as<double>(), s.consistent_change_pct, 1e-3);
+  EXPECT_DOUBLE_EQ(sj["paper"]["consistent_change_pct"].as<double>(), 30.97);
+  expectPng(out / "segmentation.png");
+
+  DescriptorExperimentConfig dc;
+  dc.preset = "tiny";
+  dc.max_frames = 80;
+  dc.segmentation = bothConfigs()[0];
+  dc.models = kSource + "/models";
+  dc.descriptors = {"semsegmap-net", "eigen"};
+  dc.threads = 2;
+  const DescriptorExperiment d = runDescriptorExperiment(dc, out);
+  const YAML::Node dj = YAML::LoadFile((out / "descriptors.json").string());
+  ASSERT_EQ(dj["descriptors"].size(), 2u);
+  EXPECT_EQ(dj["descriptors"][0]["name"].as<std::string>(), "semsegmap-net");
+  EXPECT_GT(dj["queries"].as<size_t>(), 0u);
+  for (const auto& r : dj["descriptors"]) {
+    EXPECT_EQ(r["band_curves"].size(), 4u);
+    EXPECT_LE(r["top1"].as<double>(), r["top16"].as<double>());
+  }
+  expectPng(out / "descriptors.png");
+
+  LocalizationExperimentConfig lc;
+  lc.preset = "tiny";
+  lc.max_frames = 60;
+  lc.configs = bothConfigs();
+  const LocalizationExperiment l = runLocalizationExperiment(lc, out);
+  const YAML::Node lj = YAML::LoadFile((out / "localization.json").string());
+  ASSERT_EQ(lj["results"].size(), 4u);  // S2 and S3, two configurations each
+  EXPECT_EQ(lj["thresholds_m"].size(), 101u);
+  for (const auto& r : lj["results"]) {
+    for (const char* key :
+         {"n_localizations", "n_error_below_1m", "n_error_below_5m", "mean_translation_error_m",
+          "mean_rotation_error_deg", "n_wrong", "wrong_rate", "recall_along_trajectory", "fps",
+          "map_segments", "map_bytes"})
+      EXPECT_TRUE(r[key].IsDefined()) << key;
+    EXPECT_EQ(r["frames"].as<size_t>(), 60u);
+    EXPECT_GT(r["map_segments"].as<size_t>(), 0u);
+    EXPECT_GT(r["fps"].as<double>(), 0.0);
+    const size_t n = r["n_localizations"].as<size_t>();
+    EXPECT_EQ(r["cumulative"][100].as<size_t>() + r["n_wrong"].as<size_t>(), n);
+    const std::string dir = r["dir"].as<std::string>();
+    expectPng(out / dir / "localization.png");
+    EXPECT_TRUE(std::filesystem::exists(out / dir / "localizations.csv"));
+    EXPECT_TRUE(std::filesystem::exists(out / dir / "summary.json"));
+  }
+  // S2 drives where S0 drove: SemSegMap localizes there within its first 60 frames.
+  EXPECT_GT(l.results[0].summary.localizations, 0u);
+  EXPECT_TRUE(std::filesystem::exists(out / "maps" / "semsegmap.map"));
+  expectPng(out / "localization_accuracy.png");
+
+  ReportContext context;
+  context.command = "test";
+  const std::string report = paperReport(context, &s, &d, &l);
+  for (const char* heading : {"## Segmentation consistency", "## Descriptor retrieval",
+                              "## Localization", "## Configurations and models", "+30.97 %"})
+    EXPECT_NE(report.find(heading), std::string::npos) << heading;
+  // Every picture the report shows exists.
+  for (size_t at = report.find("]("); at != std::string::npos; at = report.find("](", at + 1)) {
+    const std::string link = report.substr(at + 2, report.find(')', at) - at - 2);
+    EXPECT_TRUE(std::filesystem::exists(out / link)) << link;
+  }
+}
+
+}  // namespace
+}  // namespace semsegmap
