@@ -211,7 +211,9 @@ std::string localizationTable(const LocalizationExperiment& e) {
        "| --- | --- | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: |\n";
   char line[512];
   for (const LocalizationResult& r : e.results) {
-    const auto paper = paperLocalizations(r.run);
+    // The paper's counts are for its own full-sized runs: beside a smaller world they mislead.
+    const auto paper =
+        e.config.preset == "full" ? paperLocalizations(r.run) : std::pair<int, int>{-1, -1};
     const bool semantic = r.config.find("semsegmap") != std::string::npos;
     const int paper_n = semantic ? paper.second : paper.first;
     std::snprintf(line, sizeof(line),

@@ -42,7 +42,8 @@ std::string localizationVerdict(const LocalizationExperiment& e) {
       (r.config.find("semsegmap") != std::string::npos ? sem : seg) = &r;
     }
     if (!sem || !seg) continue;
-    const auto paper = paperLocalizations(run);
+    const auto paper =
+        e.config.preset == "full" ? paperLocalizations(run) : std::pair<int, int>{-1, -1};
     t << "- " << run << ": " << sem->config << " localized " << sem->summary.localizations
       << " times (" << sem->summary.below_1m << " within 1 m, " << sem->wrong << " wrong), "
       << seg->config << " " << seg->summary.localizations << " (" << seg->summary.below_1m << ", "
