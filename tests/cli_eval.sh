@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The eval commands as a user types them, on the tiny world with a few frames: each writes its
+# JSON and pictures, `eval paper` its report, and mistakes exit non-zero with one line.
+# Usage: cli_eval.sh SEMSEGMAP_BINARY (run from the repository's root).
+set -euo pipefail
+bin="$1"
+out="$(mktemp -d)"
+trap 'rm -rf "$out"' EXIT
+fail() { echo "cli_eval: $*" >&2; exit 1; }
+
+"$bin" eval paper --world-seed 1 --preset tiny --max-frames 30 --descriptors eigen \
+  --out "$out/paper" > "$out/paper.txt" 2> /dev/null
+for f in report.md segmentation.json segmentation.png descriptors.json descriptors.png \
+         localization.json localization_accuracy.png maps/semsegmap.map maps/segmap.map \
+         semsegmap_S2/localization.png segmap_S3/summary.json; do
+  [ -s "$out/paper/$f" ] || fail "eval paper did not write $f"
+done
+grep -q '"n_localizations"' "$out/paper/localization.json" || fail "localization.json lacks n_localizations"
+grep -q '"revisit_segments"' "$out/paper/segmentation.json" || fail "segmentation.json lacks revisit_segments"
+grep -q '## Localization' "$out/paper/report.md" || fail "report.md lacks the localization section"
+grep -q '| S3 | segmap |' "$out/paper.txt" || fail "eval paper did not print the localization table"
+
+"$bin" eval localization --preset tiny --max-frames 20 --query-runs S2 --out "$out/loc" \
+  > /dev/null 2>&1
+grep -q '"run": "S2"' "$out/loc/localization.json" || fail "eval localization --query-runs S2"
+! grep -q '"run": "S3"' "$out/loc/localization.json" || fail "eval localization ran S3 unasked"
+
+# Mistakes: one line naming what is wrong, non-zero exit.
+if "$bin" eval nonsense --out "$out/x" 2> "$out/err.txt"; then fail "eval nonsense succeeded"; fi
+grep -q "nonsense" "$out/err.txt" || fail "the error does not name the experiment"
+if "$bin" eval localization --preset tiny --configs missing.yaml --out "$out/x" 2> "$out/err.txt"; then
+  fail "a missing config succeeded"
+fi
+grep -q "missing.yaml" "$out/err.txt" || fail "the error does not name the missing config"
+echo "cli_eval: ok"
