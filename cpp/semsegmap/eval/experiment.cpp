@@ -1,5 +1,7 @@
 #include "semsegmap/eval/experiment.h"
 
+#include <stdexcept>
+
 #include "semsegmap/io/config.h"
 
 namespace semsegmap {
@@ -14,6 +16,19 @@ std::string simulatedRunSpec(uint64_t world_seed, const std::string& run, const 
       "sim:world=" + std::to_string(world_seed) + ",run=" + run + ",preset=" + preset;
   if (max_frames > 0) spec += ",frames=" + std::to_string(max_frames);
   return spec;
+}
+
+void forEachFrame(FrameSource& source, const std::string& stage, const ExperimentProgress& progress,
+                  const std::function<void(const Frame&)>& use) {
+  const size_t n = source.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Frame frame = source.frame(i);
+    if (frame.index != i)
+      throw std::logic_error(source.info().name +
+                             ": the experiments expect frames numbered from 0");
+    use(frame);
+    if (progress) progress(stage, i + 1, n);
+  }
 }
 
 }  // namespace semsegmap

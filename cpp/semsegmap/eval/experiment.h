@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "semsegmap/core/frame_source.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
 namespace semsegmap {
@@ -24,5 +25,11 @@ std::string simulatedRunSpec(uint64_t world_seed, const std::string& run, const 
 
 // Called as work advances: a stage name (e.g. "map S0") and how far it is.
 using ExperimentProgress = std::function<void(const std::string& stage, size_t done, size_t total)>;
+
+// Renders (reads) every frame of `source` once and hands it to `use`, which feeds it to every
+// configuration compared; reports progress as `stage`. The experiments index their per-frame
+// records by frame number, so frames must come numbered from 0 in order (throws otherwise).
+void forEachFrame(FrameSource& source, const std::string& stage, const ExperimentProgress& progress,
+                  const std::function<void(const Frame&)>& use);
 
 }  // namespace semsegmap

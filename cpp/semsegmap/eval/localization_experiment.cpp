@@ -18,11 +18,6 @@ namespace semsegmap {
 
 namespace {
 
-void report(const ExperimentProgress& progress, const std::string& stage, size_t done,
-            size_t total) {
-  if (progress) progress(stage, done, total);
-}
-
 LocalizationResult resultOf(const LocalizationExperimentConfig& cfg, const NamedConfig& config,
                             const std::string& run_name, const LocalizationRun& run,
                             const TargetMap& map, uint64_t map_bytes) {
@@ -47,7 +42,7 @@ LocalizationResult resultOf(const LocalizationExperimentConfig& cfg, const Named
     if (!l.T_map_robot_gt) continue;
     r.errors.push_back(l.translation_error_m);
     r.wrong += l.translation_error_m > cfg.wrong_m;
-    // Simulated frames are numbered from 0 in the order they are run.
+    // Frames are numbered from 0 in the order they are run (forEachFrame checks).
     if (l.translation_error_m < cfg.correct_m) correct.push_back(l.frame_index);
   }
   r.wrong_rate = run.localizations.empty()
@@ -82,7 +77,8 @@ std::string resultJson(const LocalizationResult& r, const std::vector<size_t>& c
 
 }  // namespace
 
-std::pair<int, int> paperLocalizations(const std::string& run) {
+std::pair<int, int> paperLocalizations(const std::string& run, const std::string& preset) {
+  if (preset != "full") return {-1, -1};
   if (run == "S2") return {126, 258};
   if (run == "S3") return {10, 108};
   return {-1, -1};
@@ -115,12 +111,9 @@ LocalizationExperiment runLocalizationExperiment(const LocalizationExperimentCon
       sessions.push_back(std::make_unique<MappingSession>(
           pc, source->info(), PoseSource::kGroundTruth, *describers[c]));
     }
-    const size_t n = source->size();
-    for (size_t i = 0; i < n; ++i) {
-      const Frame frame = source->frame(i);
+    forEachFrame(*source, "map " + cfg.map_run, progress, [&](const Frame& frame) {
       for (auto& s : sessions) s->process(frame);
-      report(progress, "map " + cfg.map_run, i + 1, n);
-    }
+    });
     for (size_t c = 0; c < cfg.configs.size(); ++c) {
       maps.push_back(sessions[c]->finish().map);
       // The saved map is what a robot carries: without the picture points.
@@ -137,12 +130,9 @@ LocalizationExperiment runLocalizationExperiment(const LocalizationExperimentCon
     for (size_t c = 0; c < cfg.configs.size(); ++c)
       sessions.push_back(std::make_unique<LocalizationSession>(
           cfg.configs[c].config, source->info(), maps[c], *describers[c]));
-    const size_t n = source->size();
-    for (size_t i = 0; i < n; ++i) {
-      const Frame frame = source->frame(i);
+    forEachFrame(*source, "localize " + run_name, progress, [&](const Frame& frame) {
       for (auto& s : sessions) s->process(frame);
-      report(progress, "localize " + run_name, i + 1, n);
-    }
+    });
     for (size_t c = 0; c < cfg.configs.size(); ++c) {
       const NamedConfig& config = cfg.configs[c];
       const LocalizationRun run = sessions[c]->take();
@@ -211,9 +201,7 @@ std::string localizationTable(const LocalizationExperiment& e) {
        "| --- | --- | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: |\n";
   char line[512];
   for (const LocalizationResult& r : e.results) {
-    // The paper's counts are for its own full-sized runs: beside a smaller world they mislead.
-    const auto paper =
-        e.config.preset == "full" ? paperLocalizations(r.run) : std::pair<int, int>{-1, -1};
+    const auto paper = paperLocalizations(r.run, e.config.preset);
     const bool semantic = r.config.find("semsegmap") != std::string::npos;
     const int paper_n = semantic ? paper.second : paper.first;
     std::snprintf(line, sizeof(line),

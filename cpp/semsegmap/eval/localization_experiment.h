@@ -57,7 +57,8 @@ LocalizationExperiment runLocalizationExperiment(const LocalizationExperimentCon
 // The results as a Markdown table (one row per run and configuration).
 std::string localizationTable(const LocalizationExperiment& e);
 
-// The paper's Table I localizations (SegMap, SemSegMap) for a simulated run; {-1, -1} if none.
-std::pair<int, int> paperLocalizations(const std::string& run);
+// The paper's Table I localizations (SegMap, SemSegMap) for a run of the full-sized world;
+// {-1, -1} for other runs and presets, beside which the paper's counts would mislead.
+std::pair<int, int> paperLocalizations(const std::string& run, const std::string& preset);
 
 }  // namespace semsegmap

@@ -42,8 +42,7 @@ std::string localizationVerdict(const LocalizationExperiment& e) {
       (r.config.find("semsegmap") != std::string::npos ? sem : seg) = &r;
     }
     if (!sem || !seg) continue;
-    const auto paper =
-        e.config.preset == "full" ? paperLocalizations(run) : std::pair<int, int>{-1, -1};
+    const auto paper = paperLocalizations(run, e.config.preset);
     t << "- " << run << ": " << sem->config << " localized " << sem->summary.localizations
       << " times (" << sem->summary.below_1m << " within 1 m, " << sem->wrong << " wrong), "
       << seg->config << " " << seg->summary.localizations << " (" << seg->summary.below_1m << ", "

@@ -41,7 +41,7 @@ FinishedSegment finishedSegment(const Segment& s) {
 // The IoU of every segment seen at a revisit with its best match among the segments finished on
 // the earlier visit.
 std::vector<double> revisitIous(const std::vector<FinishedSegment>& segments,
-                                const std::vector<Eigen::Vector3d>& positions,
+                                const std::vector<Pose>& trajectory,
                                 const std::vector<double>& travelled,
                                 const SegmentationExperimentConfig& cfg) {
   std::vector<double> ious;
@@ -49,8 +49,8 @@ std::vector<double> revisitIous(const std::vector<FinishedSegment>& segments,
     const double before = travelled.at(b.first_frame) - cfg.exclude_recent_m;
     if (before <= 0.0) continue;
     bool revisit = false;
-    for (size_t i = 0; i < positions.size() && travelled[i] < before && !revisit; ++i)
-      revisit = (positions[i] - b.centroid).head<2>().norm() < cfg.revisit_radius_m;
+    for (size_t i = 0; i < trajectory.size() && travelled[i] < before && !revisit; ++i)
+      revisit = (trajectory[i].translation() - b.centroid).head<2>().norm() < cfg.revisit_radius_m;
     if (!revisit) continue;
     double best = 0.0;
     for (const FinishedSegment& a : segments) {
@@ -108,31 +108,21 @@ SegmentationExperiment runSegmentationExperiment(const SegmentationExperimentCon
     pipelines.push_back(
         std::make_unique<Pipeline>(c.config, source->info(), PoseSource::kGroundTruth));
   std::vector<std::vector<FinishedSegment>> finished(cfg.configs.size());
-  std::vector<Eigen::Vector3d> positions;
-  const size_t n = source->size();
-  for (size_t i = 0; i < n; ++i) {
-    const Frame frame = source->frame(i);
-    if (frame.index != i)
-      throw std::logic_error("the segmentation experiment expects frames numbered from 0");
+  std::vector<Pose> trajectory;  // ground truth, one pose per frame
+  forEachFrame(*source, "segment " + cfg.run, progress, [&](const Frame& frame) {
     for (size_t c = 0; c < pipelines.size(); ++c)
       for (const Segment& s : pipelines[c]->process(frame).segmentation.finished)
         finished[c].push_back(finishedSegment(s));
-    positions.push_back(frame.T_world_base_gt->translation());
-    if (progress) progress("segment " + cfg.run, i + 1, n);
-  }
-  const std::vector<double> travelled = [&] {
-    std::vector<double> d;
-    for (size_t i = 0; i < positions.size(); ++i)
-      d.push_back(i == 0 ? 0.0 : d.back() + (positions[i] - positions[i - 1]).norm());
-    return d;
-  }();
+    trajectory.push_back(*frame.T_world_base_gt);
+  });
+  const std::vector<double> travelled = travelledDistances(trajectory);
 
   for (size_t c = 0; c < pipelines.size(); ++c) {
     for (const Segment& s : pipelines[c]->finish()) finished[c].push_back(finishedSegment(s));
     SegmentationResult r;
     r.config = cfg.configs[c].name;
     r.segments = finished[c].size();
-    r.ious = revisitIous(finished[c], positions, travelled, cfg);
+    r.ious = revisitIous(finished[c], trajectory, travelled, cfg);
     r.revisit_segments = r.ious.size();
     r.histogram = iouHistogram(r.ious, cfg.bins);
     for (double v : r.ious) (v >= cfg.consistent_iou ? r.consistent : r.inconsistent)++;
@@ -153,7 +143,7 @@ SegmentationExperiment runSegmentationExperiment(const SegmentationExperimentCon
   // JSON with every number, then the paper's figure: the histograms and the change per bin.
   std::ostringstream j;
   j << "{\n  \"world_seed\": " << cfg.world_seed << ",\n  \"preset\": " << jsonQuoted(cfg.preset)
-    << ",\n  \"run\": " << jsonQuoted(cfg.run) << ",\n  \"frames\": " << n
+    << ",\n  \"run\": " << jsonQuoted(cfg.run) << ",\n  \"frames\": " << trajectory.size()
     << ",\n  \"consistent_iou\": " << cfg.consistent_iou << ",\n  \"bins\": " << cfg.bins
     << ",\n  \"results\": [\n";
   for (size_t c = 0; c < e.results.size(); ++c) {

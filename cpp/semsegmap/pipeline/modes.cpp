@@ -7,8 +7,15 @@ namespace semsegmap {
 
 namespace {
 
-size_t framesToRun(const FrameSource& source, const RunOptions& options) {
-  return options.max_frames > 0 ? std::min(source.size(), options.max_frames) : source.size();
+// Feeds the run's frames (at most options.max_frames) to a mapping or localization session.
+template <typename Session>
+void feed(FrameSource& source, const RunOptions& options, Session& session) {
+  const size_t n =
+      options.max_frames > 0 ? std::min(source.size(), options.max_frames) : source.size();
+  for (size_t i = 0; i < n; ++i) {
+    session.process(source.frame(i));
+    if (options.progress) options.progress(i + 1, n);
+  }
 }
 
 MapSegment mapSegmentOf(const Segment& s, size_t points) {
@@ -67,11 +74,7 @@ MappingRun MappingSession::finish() {
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
                       Describer& describer, const RunOptions& options) {
   MappingSession session(config, source.info(), poses, describer);
-  const size_t n = framesToRun(source, options);
-  for (size_t i = 0; i < n; ++i) {
-    session.process(source.frame(i));
-    if (options.progress) options.progress(i + 1, n);
-  }
+  feed(source, options, session);
   return session.finish();
 }
 
@@ -130,11 +133,7 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
                                 const TargetMap& map, Describer& describer,
                                 const RunOptions& options) {
   LocalizationSession session(config, source.info(), map, describer);
-  const size_t n = framesToRun(source, options);
-  for (size_t i = 0; i < n; ++i) {
-    session.process(source.frame(i));
-    if (options.progress) options.progress(i + 1, n);
-  }
+  feed(source, options, session);
   return session.take();
 }
 

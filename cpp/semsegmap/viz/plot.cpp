@@ -23,12 +23,12 @@ std::string quoted(const std::string& s) {
   return out + "'";
 }
 
-// Bars of several series share each x: each gets a slot of the spacing between x values.
-double barWidth(const Panel& panel) {
+// The distance between neighbouring x values of bars (1 when there is only one).
+double barSpacing(const Panel& panel) {
   double spacing = 1.0;
   for (const Series& s : panel.series)
     if (s.x.size() >= 2) spacing = std::abs(s.x[1] - s.x[0]);
-  return 0.8 * spacing / static_cast<double>(std::max<size_t>(1, panel.series.size()));
+  return spacing;
 }
 
 }  // namespace
@@ -53,7 +53,10 @@ void plotPanels(const std::filesystem::path& png, const std::string& title,
     else
       gp << "set yrange [" << panel.y_min << ":" << panel.y_max << "]\n";
     gp << (panel.log_x ? "set logscale x\n" : "unset logscale x\n");
-    const double bar = barWidth(panel);
+    // Bars of several series share each x: each gets a slot of 0.8 of the spacing.
+    const double spacing = barSpacing(panel);
+    const double bar =
+        0.8 * spacing / static_cast<double>(std::max<size_t>(1, panel.series.size()));
     if (panel.style == PlotStyle::kBars) {
       // The x range spans the bins exactly; autoscaled y gets headroom for the labels.
       double lo = 0, hi = 0;
@@ -64,8 +67,7 @@ void plotPanels(const std::filesystem::path& png, const std::string& title,
           hi = any ? std::max(hi, x) : x;
           any = true;
         }
-      const double half =
-          0.5 * bar * static_cast<double>(std::max<size_t>(1, panel.series.size())) / 0.8;
+      const double half = 0.5 * spacing;
       gp << "set boxwidth " << bar << " absolute\nset style fill solid 0.75 border -1\n"
          << "set xzeroaxis lt -1\nset key top right\nset offsets 0, 0, graph 0.1, graph 0.05\n";
       if (any) gp << "set xrange [" << lo - half << ":" << hi + half << "]\n";
