@@ -11,6 +11,7 @@
 
 #include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/describe/learned_net.h"
+#include "semsegmap/io/model_file.h"
 
 using namespace semsegmap;
 
@@ -88,8 +89,8 @@ std::string modelFile(DescriptorKind kind) {
 // state.range(0): descriptor kind (2 segmap-cnn, 3 semsegmap-net); range(1): threads.
 void BM_LearnedDescribe(benchmark::State& state) {
   const auto kind = static_cast<DescriptorKind>(state.range(0));
-  const auto describer =
-      makeLearnedDescriber(kind, {modelFile(kind), static_cast<int>(state.range(1))});
+  const auto describer = makeLearnedDescriber(
+      kind, {loadNet(modelFile(kind), kind), static_cast<int>(state.range(1))});
   std::vector<DescriptorInput> batch;
   for (const EnrichedCloud& s : segments()) batch.push_back({&s});
   for (auto _ : state) {

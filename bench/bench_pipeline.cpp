@@ -6,6 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include "semsegmap/io/config.h"
+#include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/sim/simulator.h"
 
@@ -44,7 +45,7 @@ void BM_WholePipeline(benchmark::State& state) {
   const std::string name = state.range(0) == 0 ? "semsegmap" : "segmap";
   const PipelineConfig config =
       loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/" + name + ".yaml");
-  std::unique_ptr<Describer> describer;
+  std::shared_ptr<Describer> describer;
   try {
     describer = makeDescriber(config.descriptor);
   } catch (const std::exception& e) {
@@ -53,25 +54,28 @@ void BM_WholePipeline(benchmark::State& state) {
   }
   static Recorded mapping = s2Frames("sunrise", 11);
   static Recorded query = s2Frames("sunny", 12);
-  const TargetMap map = runMapping(mapping, config, PoseSource::kGroundTruth, *describer).map;
-  const Localizer localizer(map, config.localization.localizer);
-  std::unique_ptr<Pipeline> pipeline;
+  const auto map = std::make_shared<const TargetMap>(
+      runMapping(mapping, config, PoseSource::kGroundTruth, describer).map);
+  std::unique_ptr<LocalizationSession> session;
   size_t i = 0, localized = 0, frames = 0;
   StageTimes total;
+  const auto lap = [&] {  // adds up a finished pass over the query frames
+    if (!session) return;
+    localized += session->run().localizations.size();
+    total += session->run().stats.total;
+  };
   for (auto _ : state) {
-    if (!pipeline || i == query.size()) {
+    if (!session || i == query.size()) {
       state.PauseTiming();
-      pipeline =
-          std::make_unique<Pipeline>(config, query.info(), PoseSource::kOdometry, describer.get());
-      pipeline->setLocalizer(&localizer);
+      lap();
+      session = std::make_unique<LocalizationSession>(config, query.info(), map, describer);
       i = 0;
       state.ResumeTiming();
     }
-    const FrameResult r = pipeline->process(query.at(i++));
-    localized += r.localization.has_value();
-    total += r.times;
+    session->process(query.at(i++));
     ++frames;
   }
+  lap();
   state.SetLabel(name + " + " + config.descriptor.kind);
   const double n = static_cast<double>(std::max<size_t>(1, frames));
   state.counters["localized"] = static_cast<double>(localized) / n;

@@ -66,7 +66,7 @@ void BM_LocalMapAndSegmentation(benchmark::State& state) {
       i = 0;
       state.ResumeTiming();
     }
-    const Pose T = *r.frames[i].T_world_base_gt;
+    const Pose T = *r.frames[i].T_world_base;
     const LocalMapUpdate u =
         map->update(r.clouds[i], T * r.info.rig.T_base_lidar, T.translation().head<2>());
     auto s = segmenter->update(*map, u, i, r.frames[i].timestamp_s);
@@ -104,7 +104,7 @@ void BM_LocalMapOnly(benchmark::State& state) {
       i = 0;
       state.ResumeTiming();
     }
-    const Pose T = *r.frames[i].T_world_base_gt;
+    const Pose T = *r.frames[i].T_world_base;
     const LocalMapUpdate u =
         map->update(r.clouds[i], T * r.info.rig.T_base_lidar, T.translation().head<2>());
     benchmark::DoNotOptimize(u.newly_active.data());

@@ -32,7 +32,7 @@ BENCHMARK(BM_SimulateFrame)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTi
 
 void BM_Lidar(benchmark::State& state) {
   auto& s = fullSimulator();
-  const Pose T = s.trajectory().T_world_base_gt[50] * s.info().rig.T_base_lidar;
+  const Pose T = s.trajectory().T_world_base[50] * s.info().rig.T_base_lidar;
   for (auto _ : state) {
     auto scan = sim::simulateLidar(s.scene(), s.info().rig.lidar, T, 1);
     benchmark::DoNotOptimize(scan.points.data());
@@ -44,7 +44,7 @@ void BM_Camera(benchmark::State& state) {
   auto& s = fullSimulator();
   const auto& cam = s.info().rig.cameras[1];
   const Pose T =
-      s.trajectory().T_world_base_gt[50] * s.info().rig.T_base_lidar * cam.T_camera_lidar.inverse();
+      s.trajectory().T_world_base[50] * s.info().rig.T_base_lidar * cam.T_camera_lidar.inverse();
   for (auto _ : state) {
     auto r = sim::renderCamera(s.scene(), cam, T, s.lighting(), 1);
     benchmark::DoNotOptimize(r.rgb.data.data());

@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libtorch-dev libpcl-dev libqhull-dev libfaiss-dev libceres-dev
   libopenblas0-openmp
+  nlohmann-json3-dev
   gnuplot-nox
 )
 

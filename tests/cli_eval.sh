@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The eval commands as a user types them, on the tiny world with a few frames: each writes its
 # JSON and pictures, `eval paper` its report, and mistakes exit non-zero with one line.
-# Usage: cli_eval.sh SEMSEGMAP_BINARY (run from the repository's root).
+# Usage: cli_eval.sh SEMSEGMAP_BINARY. It runs in a temporary folder outside the repository: the
+# default configs and models must be found wherever the command runs.
 set -euo pipefail
 bin="$1"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
+cd "$out"
 fail() { echo "cli_eval: $*" >&2; exit 1; }
 
 "$bin" eval paper --world-seed 1 --preset tiny --max-frames 30 --descriptors eigen \

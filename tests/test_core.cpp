@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
 
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/class_table.h"
+#include "semsegmap/core/json.h"
 #include "semsegmap/core/pose.h"
 #include "semsegmap/core/random.h"
 #include "semsegmap/core/sensor_rig.h"
+#include "temp_dir.h"
 
 using namespace semsegmap;
 
@@ -26,6 +30,21 @@ TEST(ClassTable, DefaultHasThePaperClassesWithTheirFlags) {
 TEST(ClassTable, RejectsDuplicateIds) {
   EXPECT_THROW(ClassTable({{1, "a", {0, 0, 0}, false, false}, {1, "b", {0, 0, 0}, false, false}}),
                std::invalid_argument);
+}
+
+// The one layout of every JSON file: keys in the order they were set, a 2-space indent, a final
+// newline; quotes and backslashes escaped, so that what is written reads back unchanged.
+TEST(Json, WritesOrderedIndentedEscapedText) {
+  nlohmann::ordered_json j;
+  j["name"] = "a \"quoted\" C:\\path";
+  j["count"] = 3;
+  j["values"] = {0.1, 2.5};
+  EXPECT_EQ(jsonText(j),
+            "{\n  \"name\": \"a \\\"quoted\\\" C:\\\\path\",\n  \"count\": 3,\n"
+            "  \"values\": [\n    0.1,\n    2.5\n  ]\n}\n");
+  test_support::TempDir tmp;
+  writeJsonAtomically(tmp.path() / "j.json", j);
+  EXPECT_EQ(nlohmann::ordered_json::parse(readFileBytes(tmp.path() / "j.json")), j);
 }
 
 TEST(Pose, XyzQuatRoundTrip) {

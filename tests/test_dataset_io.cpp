@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/io/dataset_format.h"
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
@@ -126,8 +126,8 @@ Frame tinyFrame(size_t index, bool with_gt) {
       }
     f.cameras.push_back(cam);
   }
-  f.T_world_base_odom = somePose(0.01 * static_cast<double>(index + 1), 2.0, 3.0);
-  if (with_gt) f.T_world_base_gt = somePose(0.02 * static_cast<double>(index + 1), 1.0, 0.5);
+  f.T_odom_base = somePose(0.01 * static_cast<double>(index + 1), 2.0, 3.0);
+  if (with_gt) f.T_world_base = somePose(0.02 * static_cast<double>(index + 1), 1.0, 0.5);
   return f;
 }
 
@@ -152,10 +152,10 @@ void expectSameFrame(const Frame& a, const Frame& b) {
     EXPECT_EQ(a.cameras[k].rgb, b.cameras[k].rgb) << "camera " << k;
     EXPECT_EQ(a.cameras[k].label, b.cameras[k].label) << "camera " << k;
   }
-  EXPECT_LT(poseDifference(a.T_world_base_odom, b.T_world_base_odom), 1e-12);
-  ASSERT_EQ(a.T_world_base_gt.has_value(), b.T_world_base_gt.has_value());
-  if (a.T_world_base_gt) {
-    EXPECT_LT(poseDifference(*a.T_world_base_gt, *b.T_world_base_gt), 1e-12);
+  EXPECT_LT(poseDifference(a.T_odom_base, b.T_odom_base), 1e-12);
+  ASSERT_EQ(a.T_world_base.has_value(), b.T_world_base.has_value());
+  if (a.T_world_base) {
+    EXPECT_LT(poseDifference(*a.T_world_base, *b.T_world_base), 1e-12);
   }
 }
 

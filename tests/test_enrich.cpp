@@ -15,11 +15,11 @@
 
 #include <Eigen/Dense>
 
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/enrich/enricher.h"
-#include "semsegmap/io/atomic_file.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/kitti_raw_reader.h"
-#include "semsegmap/io/open_dataset.h"
 #include "semsegmap/io/ply_writer.h"
 
 namespace semsegmap {

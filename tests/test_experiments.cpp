@@ -5,9 +5,10 @@
 
 #include <cmath>
 
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/json.h"
 #include "semsegmap/eval/localization_metrics.h"
 #include "semsegmap/eval/report.h"
-#include "semsegmap/io/atomic_file.h"
 #include "temp_dir.h"
 
 namespace semsegmap {
@@ -50,6 +51,43 @@ TEST(LocalizationMetrics, RecallAlongTheTrajectory) {
   const std::vector<Pose> line = {planarPose(0, 0, 0, 0), planarPose(3, 4, 0, 1),
                                   planarPose(3, 4, 0, 2)};
   EXPECT_EQ(travelledDistances(line), (std::vector<double>{0.0, 5.0, 5.0}));
+}
+
+// Names are written escaped: configuration, descriptor, dataset and directory names with a quote
+// and a backslash read back from every experiment's JSON as they were.
+TEST(Experiments, NamesWithQuotesAndBackslashesRoundTripThroughTheJson) {
+  TempDir tmp;
+  const std::string name = "my \"odd\" C:\\name";
+  auto readBack = [&](const nlohmann::ordered_json& j) {
+    writeJsonAtomically(tmp.path() / "e.json", j);
+    return nlohmann::json::parse(readFileBytes(tmp.path() / "e.json"));
+  };
+
+  SegmentationExperiment s;
+  s.config.preset = name;
+  s.results.emplace_back().config = name;
+  const nlohmann::json sj = readBack(toJson(s));
+  EXPECT_EQ(sj["preset"], name);
+  EXPECT_EQ(sj["results"][0]["config"], name);
+
+  DescriptorExperiment d;
+  d.dataset = name;
+  d.bands = {{0.0, 1.0, name}};
+  d.results.emplace_back().descriptor = name;
+  const nlohmann::json dj = readBack(toJson(d));
+  EXPECT_EQ(dj["dataset"], name);
+  EXPECT_EQ(dj["bands"][0], name);
+  EXPECT_EQ(dj["descriptors"][0]["name"], name);
+
+  LocalizationExperiment l;
+  l.config.map_run = name;
+  LocalizationResult& r = l.results.emplace_back();
+  r.config = r.descriptor = r.run = r.dataset = name;
+  r.dir = name;
+  const nlohmann::json lj = readBack(toJson(l));
+  EXPECT_EQ(lj["map_run"], name);
+  for (const char* key : {"config", "descriptor", "run", "dataset", "dir"})
+    EXPECT_EQ(lj["results"][0][key], name) << key;
 }
 
 TEST(SegmentationExperiment, HistogramAndRelativeChange) {

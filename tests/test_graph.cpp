@@ -16,6 +16,7 @@
 
 #include "semsegmap/graph/pose_graph.h"
 #include "semsegmap/graph/trajectory.h"
+#include "semsegmap/io/trajectory_file.h"
 #include "temp_dir.h"
 
 namespace semsegmap {

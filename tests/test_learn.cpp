@@ -6,6 +6,10 @@
 #include <map>
 #include <set>
 
+#include "semsegmap/datasets/dataset_specs.h"
+#include "semsegmap/datasets/open_dataset.h"
+#include "semsegmap/io/model_file.h"
+#include "semsegmap/io/training_cache.h"
 #include "semsegmap/learn/augment.h"
 #include "semsegmap/learn/trainer.h"
 #include "semsegmap/learn/training_data.h"
@@ -345,7 +349,8 @@ TrainingSet* SimulatedData::data_ = nullptr;
 TEST_F(SimulatedData, ExtractionGivesObservationsWithPointsAndInstances) {
   const TrainingSet& set = *data_;
   ASSERT_GT(set.observations.size(), 40u);
-  EXPECT_EQ(ExtractionConfig{}.first_transient_instance, sim::kTrafficInstanceBase);
+  EXPECT_EQ(openDataset("sim:world=1,run=S2,preset=tiny,frames=1")->info().first_transient_instance,
+            sim::kTrafficInstanceBase);
   ASSERT_EQ(set.source_worlds.size(), 2u);
   EXPECT_EQ(set.source_worlds[0], set.source_worlds[1]) << "one world, two conditions";
   std::map<uint16_t, std::set<uint16_t>> sources_of;
@@ -401,7 +406,8 @@ TEST_F(SimulatedData, AFewStepsTrainReduceTheLossAndWriteAModel) {
     int epochs_seen = 0;
     TrainCallbacks callbacks;
     callbacks.epoch = [&](const EpochStats&) { ++epochs_seen; };
-    const TrainResult result = trainDescriptor(*data_, config, out, callbacks);
+    callbacks.best = [&](DescriptorNetImpl& net) { saveNet(out, net); };
+    const TrainResult result = trainDescriptor(*data_, config, callbacks);
     ASSERT_EQ(result.history.size(), 6u);
     EXPECT_EQ(epochs_seen, 6);
     EXPECT_GT(result.anchors, 0u);

@@ -17,6 +17,7 @@
 #include "semsegmap/describe/net_input.h"
 #include "semsegmap/describe/pointnet_ops.h"
 #include "semsegmap/describe/semsegmap_net.h"
+#include "semsegmap/io/model_file.h"
 
 using namespace semsegmap;
 
@@ -365,10 +366,10 @@ TEST(ModelFile, RoundTripAndErrors) {
     expectFileError([&] { loadNet(truncated); }, truncated, "truncated");
 
     std::string other_version = bytes;
-    other_version[6] = 2;  // the format version follows the 6-byte magic
+    other_version[6] = 3;  // the format version follows the 6-byte magic
     const auto future = dir / "future.ssmnet";
     writeBytes(future, other_version);
-    expectFileError([&] { loadNet(future); }, future, "version 2");
+    expectFileError([&] { loadNet(future); }, future, "version 3");
 
     const auto bad_magic = dir / "bad_magic.ssmnet";
     writeBytes(bad_magic, "X" + bytes.substr(1));
@@ -393,12 +394,52 @@ TEST(ModelFile, RoundTripAndErrors) {
   expectFileError([&] { loadNet(cnn, DescriptorKind::kSemSegMapNet); }, cnn,
                   "expected semsegmap-net");
   expectFileError([&] { loadNet(dir / "missing.ssmnet"); }, dir / "missing.ssmnet", "cannot open");
-  expectFileError(
-      [&] {
-        makeLearnedDescriber(DescriptorKind::kSemSegMapNet, {cnn.string(), 1});
-      },
-      cnn, "segmap-cnn");
+  // A network of another kind is refused by the describer too.
+  EXPECT_THROW(makeLearnedDescriber(DescriptorKind::kSemSegMapNet,
+                                    {loadNet(cnn, DescriptorKind::kSegMapCnn), 1}),
+               std::invalid_argument);
   std::filesystem::remove_all(dir);
+}
+
+// The set abstraction is in the model file (format version 2) and in the fingerprint: an edited
+// radius is another model, while the models of version 1, trained with the defaults, keep their
+// fingerprints and so the maps built with them.
+TEST(ModelFile, SetAbstractionIsRecordedAndFingerprinted) {
+  const auto dir = tempDir();
+  torch::manual_seed(4);
+  NetConfig config = tinyConfig(DescriptorKind::kSemSegMapNet);
+  const auto net = makeNet(config);
+  config.sa1_radius = 0.25f;
+  config.sa_neighbours = 8;
+  torch::manual_seed(4);
+  const auto edited = makeNet(config);  // the same weights, another grouping
+  EXPECT_NE(netFingerprint(*edited), netFingerprint(*net));
+  const auto path = dir / "edited.ssmnet";
+  saveNet(path, *edited);
+  const Model model = readModelFile(path);
+  EXPECT_FLOAT_EQ(model.config.sa1_radius, 0.25f);
+  EXPECT_EQ(model.config.sa_neighbours, 8);
+  EXPECT_EQ(loadNet(path)->config().sa_neighbours, 8);
+  NetConfig bad = config;
+  bad.sa2_divisor = 3;  // num_points is no multiple of it
+  EXPECT_THROW(validateNetConfig(bad), std::invalid_argument);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ModelFile, ShippedVersionOneModelsLoadWithTheirFingerprints) {
+  for (const char* name : {"semsegmap-net", "segmap-cnn"}) {
+    const auto path =
+        std::filesystem::path(SEMSEGMAP_SOURCE_DIR) / "models" / (name + std::string(".model"));
+    const std::string bytes = readBytes(path);
+    ASSERT_GT(bytes.size(), 10u);
+    SCOPED_TRACE(name);
+    EXPECT_EQ(bytes[6], 1) << "the shipped models were written in format version 1";
+    const Model model = readModelFile(path);
+    EXPECT_EQ(model.config.sa1_divisor, 4);
+    EXPECT_FLOAT_EQ(model.config.sa2_radius, 0.4f);
+    const auto net = netFromModel(model);  // checks the stored fingerprint
+    EXPECT_EQ(netFingerprint(*net), model.fingerprint);
+  }
 }
 
 // ---- inference ---------------------------------------------------------------------------------
@@ -415,7 +456,7 @@ TEST(LearnedDescriber, RepeatableAndIndependentOfPointOrderAndBatch) {
     const auto net = makeNet(config);
     const auto path = dir / "model.ssmnet";
     saveNet(path, *net);
-    const auto describer = makeLearnedDescriber(kind, {path.string(), 2});
+    const auto describer = makeLearnedDescriber(kind, {loadNet(path, kind), 2});
     EXPECT_EQ(describer->kind(), kind);
     EXPECT_EQ(describer->dimension(), config.descriptor_dim);
     EXPECT_EQ(describer->fingerprint(), netFingerprint(*net));

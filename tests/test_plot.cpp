@@ -4,7 +4,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/viz/plot.h"
 #include "temp_dir.h"
 

@@ -20,6 +20,7 @@
 #include "semsegmap/io/kitti_raw_reader.h"
 #include "semsegmap/io/nclt_reader.h"
 #include "semsegmap/io/semantic_kitti_reader.h"
+#include "semsegmap/io/trajectory_file.h"
 #include "temp_dir.h"
 
 namespace semsegmap {
@@ -32,6 +33,16 @@ const fs::path kDay =
 const fs::path kDrive = kDay / "sample_sync";
 
 using semsegmap::test_support::TempDir;
+
+// Every KittiRaw test reads the real sample, or copies parts of it to break them.
+class KittiRaw : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(kDrive))
+      GTEST_SKIP() << "the real KITTI sample is absent (" << kDrive.string()
+                   << "): ../shared/data is not beside this checkout";
+  }
+};
 
 std::string errorOf(const std::function<void()>& f) {
   try {
@@ -114,7 +125,7 @@ fs::path copyKittiSample(const fs::path& root, int frames) {
   return drive;
 }
 
-TEST(KittiRaw, RealSampleLoads) {
+TEST_F(KittiRaw, RealSampleLoads) {
   KittiRawReader reader(kDrive);
   ASSERT_EQ(reader.size(), 10u);
   const DatasetInfo& info = reader.info();
@@ -143,14 +154,14 @@ TEST(KittiRaw, RealSampleLoads) {
     EXPECT_EQ(f.cameras[0].rgb.height, 375);
     EXPECT_EQ(f.cameras[0].rgb.channels, 3);
     EXPECT_TRUE(f.cameras[0].label.empty());
-    EXPECT_TRUE(f.T_world_base_odom.isApprox(Pose::Identity()));
-    EXPECT_FALSE(f.T_world_base_gt.has_value());
+    EXPECT_TRUE(f.T_odom_base.isApprox(Pose::Identity()));
+    EXPECT_FALSE(f.T_world_base.has_value());
   }
   // The first scan is 1828448 bytes of 16-byte points.
   EXPECT_EQ(reader.frame(0).points.size(), 1828448u / 16u);
 }
 
-TEST(KittiRaw, ProjectionMatchesTheDevkitFormula) {
+TEST_F(KittiRaw, ProjectionMatchesTheDevkitFormula) {
   // Copied from the sample's calib_cam_to_cam.txt (P_rect_02, R_rect_00) and
   // calib_velo_to_cam.txt (R, T).
   const double P[3][4] = {{7.215377e+02, 0.000000e+00, 6.095593e+02, 4.485728e+01},
@@ -195,7 +206,7 @@ TEST(KittiRaw, ProjectionMatchesTheDevkitFormula) {
   EXPECT_GT(in_image, 100);  // the calibration lines the scan up with the picture
 }
 
-TEST(KittiRaw, CalibrationTwoLevelsUpAndTimestampsAreRead) {
+TEST_F(KittiRaw, CalibrationTwoLevelsUpAndTimestampsAreRead) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path() / "root", 2);
   // Move the day's calibration one level further up: root/calib_*, root/2011_09_26/drive.
@@ -211,7 +222,7 @@ TEST(KittiRaw, CalibrationTwoLevelsUpAndTimestampsAreRead) {
   EXPECT_NEAR(f0.timestamp_s, 1316995200.0 + 13 * 3600 + 2 * 60 + 25.964389445, 1e-5);
 }
 
-TEST(KittiRaw, OxtsBecomeLidarPosesRelativeToTheFirstFrame) {
+TEST_F(KittiRaw, OxtsBecomeLidarPosesRelativeToTheFirstFrame) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 2);
   // Frame 1 is 1e-5 degrees of latitude north of frame 0 and has turned 0.1 rad left.
@@ -228,9 +239,9 @@ TEST(KittiRaw, OxtsBecomeLidarPosesRelativeToTheFirstFrame) {
   KittiRawReader reader(drive);
   EXPECT_TRUE(reader.info().has_ground_truth_poses);
   const Frame f0 = reader.frame(0), f1 = reader.frame(1);
-  ASSERT_TRUE(f0.T_world_base_gt && f1.T_world_base_gt);
-  EXPECT_TRUE(f0.T_world_base_gt->isApprox(Pose::Identity(), 1e-9));
-  EXPECT_TRUE(f1.T_world_base_odom.isApprox(*f1.T_world_base_gt));
+  ASSERT_TRUE(f0.T_world_base && f1.T_world_base);
+  EXPECT_TRUE(f0.T_world_base->isApprox(Pose::Identity(), 1e-9));
+  EXPECT_TRUE(f1.T_odom_base.isApprox(*f1.T_world_base));
 
   // IMU motion: Mercator north = earth radius * dlat (scale cos(lat0) cancels 1 / cos(lat)),
   // about 1.113 m, and a 0.1 rad turn. The LiDAR moves by the same motion seen through the
@@ -243,12 +254,12 @@ TEST(KittiRaw, OxtsBecomeLidarPosesRelativeToTheFirstFrame) {
       -1.482298e-02, 2.024406e-03, 1.482454e-02, 9.998881e-01;
   T_velo_imu.translation() << -8.086759e-01, 3.195559e-01, -7.997231e-01;
   const Pose expected = T_velo_imu * T_imu0_imu1 * T_velo_imu.inverse(Eigen::Affine);
-  EXPECT_LT(translationError(*f1.T_world_base_gt, expected), 1e-3);
-  EXPECT_LT(rotationErrorDeg(*f1.T_world_base_gt, expected), 1e-3);
-  EXPECT_NEAR(Eigen::AngleAxisd(f1.T_world_base_gt->linear()).angle(), 0.1, 1e-6);
+  EXPECT_LT(translationError(*f1.T_world_base, expected), 1e-3);
+  EXPECT_LT(rotationErrorDeg(*f1.T_world_base, expected), 1e-3);
+  EXPECT_NEAR(Eigen::AngleAxisd(f1.T_world_base->linear()).angle(), 0.1, 1e-6);
 }
 
-TEST(KittiRaw, MissingCalibrationFileIsNamed) {
+TEST_F(KittiRaw, MissingCalibrationFileIsNamed) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 1);
   fs::remove(drive.parent_path() / "calib_velo_to_cam.txt");
@@ -257,7 +268,7 @@ TEST(KittiRaw, MissingCalibrationFileIsNamed) {
   EXPECT_MENTIONS(msg, "not found");
 }
 
-TEST(KittiRaw, MissingCalibrationKeyIsNamed) {
+TEST_F(KittiRaw, MissingCalibrationKeyIsNamed) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 1);
   replaceCalibLine(drive.parent_path() / "calib_cam_to_cam.txt", "P_rect_02:", "");
@@ -265,7 +276,7 @@ TEST(KittiRaw, MissingCalibrationKeyIsNamed) {
   EXPECT_MENTIONS(msg, "calib_cam_to_cam.txt: P_rect_02: missing");
 }
 
-TEST(KittiRaw, WrongValueCountIsNamed) {
+TEST_F(KittiRaw, WrongValueCountIsNamed) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 1);
   replaceCalibLine(drive.parent_path() / "calib_cam_to_cam.txt",
@@ -274,7 +285,7 @@ TEST(KittiRaw, WrongValueCountIsNamed) {
   EXPECT_MENTIONS(msg, "calib_cam_to_cam.txt: R_rect_00: expected 9 values, found 8");
 }
 
-TEST(KittiRaw, NonRotationIsRejected) {
+TEST_F(KittiRaw, NonRotationIsRejected) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 1);
   replaceCalibLine(drive.parent_path() / "calib_velo_to_cam.txt", "R:", "R: 2 0 0 0 1 0 0 0 1");
@@ -282,7 +293,7 @@ TEST(KittiRaw, NonRotationIsRejected) {
   EXPECT_MENTIONS(msg, "calib_velo_to_cam.txt: R: not a rotation matrix");
 }
 
-TEST(KittiRaw, NonNumericValueIsNamed) {
+TEST_F(KittiRaw, NonNumericValueIsNamed) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 1);
   replaceCalibLine(drive.parent_path() / "calib_velo_to_cam.txt", "T:", "T: 0.1 abc 0.3");
@@ -290,7 +301,7 @@ TEST(KittiRaw, NonNumericValueIsNamed) {
   EXPECT_MENTIONS(msg, "calib_velo_to_cam.txt: T: 'abc' is not a finite number");
 }
 
-TEST(KittiRaw, ImageOfTheWrongSizeIsNamed) {
+TEST_F(KittiRaw, ImageOfTheWrongSizeIsNamed) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 2);
   const fs::path png = drive / "image_02" / "data" / "0000000001.png";
@@ -304,7 +315,7 @@ TEST(KittiRaw, ImageOfTheWrongSizeIsNamed) {
   EXPECT_MENTIONS(msg, "1242x375");
 }
 
-TEST(KittiRaw, MissingImageIsNamed) {
+TEST_F(KittiRaw, MissingImageIsNamed) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 2);
   fs::remove(drive / "image_02" / "data" / "0000000001.png");
@@ -312,7 +323,7 @@ TEST(KittiRaw, MissingImageIsNamed) {
   EXPECT_MENTIONS(msg, "0000000001.png: missing");
 }
 
-TEST(KittiRaw, TruncatedScanIsNamed) {
+TEST_F(KittiRaw, TruncatedScanIsNamed) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 1);
   const fs::path bin = drive / "velodyne_points" / "data" / "0000000000.bin";
@@ -323,7 +334,7 @@ TEST(KittiRaw, TruncatedScanIsNamed) {
   EXPECT_MENTIONS(msg, "truncated");
 }
 
-TEST(KittiRaw, NonFiniteCoordinateIsNamedWithItsIndex) {
+TEST_F(KittiRaw, NonFiniteCoordinateIsNamedWithItsIndex) {
   TempDir tmp;
   const fs::path drive = copyKittiSample(tmp.path(), 1);
   const fs::path bin = drive / "velodyne_points" / "data" / "0000000000.bin";
@@ -463,15 +474,15 @@ TEST(SemanticKitti, DecodesPointsLabelsTimesAndPoses) {
     }
     // Tr^-1 * T_world_cam0 * Tr means: a LiDAR point moved to the world and then seen in camera
     // coordinates equals the camera's world pose applied to the same point seen by the camera.
-    ASSERT_TRUE(f.T_world_base_gt.has_value());
-    EXPECT_TRUE(f.T_world_base_odom.isApprox(*f.T_world_base_gt));
+    ASSERT_TRUE(f.T_world_base.has_value());
+    EXPECT_TRUE(f.T_odom_base.isApprox(*f.T_world_base));
     for (const Eigen::Vector3d& X : {Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(-20, 5, -1)}) {
-      const Eigen::Vector3d lhs = fx.Tr * (*f.T_world_base_gt * X);
+      const Eigen::Vector3d lhs = fx.Tr * (*f.T_world_base * X);
       const Eigen::Vector3d rhs = fx.T_world_cam0[k] * (fx.Tr * X);
       EXPECT_LT((lhs - rhs).norm(), 1e-9) << "frame " << k;
     }
   }
-  EXPECT_TRUE(reader.frame(0).T_world_base_gt->isApprox(Pose::Identity(), 1e-12));
+  EXPECT_TRUE(reader.frame(0).T_world_base->isApprox(Pose::Identity(), 1e-12));
 }
 
 TEST(SemanticKitti, EveryMappedClassIsInTheDefaultTable) {
@@ -499,7 +510,7 @@ TEST(SemanticKitti, LabelsAndPosesAreOptional) {
   const Frame f = reader.frame(2);
   EXPECT_EQ(f.points.size(), 7u);
   EXPECT_TRUE(f.point_labels.empty());
-  EXPECT_FALSE(f.T_world_base_gt.has_value());
+  EXPECT_FALSE(f.T_world_base.has_value());
   EXPECT_NEAR(f.timestamp_s, 0.2, 1e-12);
 }
 
@@ -623,26 +634,26 @@ TEST(Nclt, GroundTruthIsInterpolatedAndTurnedZUp) {
   EXPECT_TRUE(reader.info().rig.T_base_lidar.isApprox(F));
 
   const Frame f0 = reader.frame(0), f1 = reader.frame(1), f2 = reader.frame(2);
-  EXPECT_FALSE(f0.T_world_base_gt.has_value());  // before the first valid row
+  EXPECT_FALSE(f0.T_world_base.has_value());  // before the first valid row
   // Its odometry holds the first known pose (x 10, y 20, z -1, yaw 0.2 in NED).
-  EXPECT_LT((f0.T_world_base_odom.translation() - Eigen::Vector3d(10, -20, 1)).norm(), 1e-12);
+  EXPECT_LT((f0.T_odom_base.translation() - Eigen::Vector3d(10, -20, 1)).norm(), 1e-12);
 
   // Halfway between (10, 20, -1, yaw 0.2) and (12, 24, -3, yaw 0.6): (11, 22, -2, yaw 0.4) in
   // NED, i.e. (11, -22, 2) with yaw -0.4 in the z-up world.
-  ASSERT_TRUE(f1.T_world_base_gt.has_value());
-  EXPECT_LT((f1.T_world_base_gt->translation() - Eigen::Vector3d(11, -22, 2)).norm(), 1e-9);
-  EXPECT_NEAR(yawOf(*f1.T_world_base_gt), -0.4, 1e-9);
-  EXPECT_TRUE(f1.T_world_base_odom.isApprox(*f1.T_world_base_gt));
+  ASSERT_TRUE(f1.T_world_base.has_value());
+  EXPECT_LT((f1.T_world_base->translation() - Eigen::Vector3d(11, -22, 2)).norm(), 1e-9);
+  EXPECT_NEAR(yawOf(*f1.T_world_base), -0.4, 1e-9);
+  EXPECT_TRUE(f1.T_odom_base.isApprox(*f1.T_world_base));
 
   // Exactly on a row, with roll and pitch: R = Rz(yaw) Ry(pitch) Rx(roll), conjugated by F.
-  ASSERT_TRUE(f2.T_world_base_gt.has_value());
+  ASSERT_TRUE(f2.T_world_base.has_value());
   const Eigen::Matrix3d R_ned = (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
                                  Eigen::AngleAxisd(-0.02, Eigen::Vector3d::UnitY()) *
                                  Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()))
                                     .toRotationMatrix();
   const Eigen::Matrix3d Fm = F.linear();
-  EXPECT_TRUE(f2.T_world_base_gt->linear().isApprox(Fm * R_ned * Fm, 1e-12));
-  EXPECT_LT((f2.T_world_base_gt->translation() - Eigen::Vector3d(13, -25, 4)).norm(), 1e-12);
+  EXPECT_TRUE(f2.T_world_base->linear().isApprox(Fm * R_ned * Fm, 1e-12));
+  EXPECT_LT((f2.T_world_base->translation() - Eigen::Vector3d(13, -25, 4)).norm(), 1e-12);
 
   // A point on the robot's left in the z-up base is at negative y in NCLT's body (right) frame.
   const Eigen::Vector3d left_in_base = reader.info().rig.T_base_lidar * Eigen::Vector3d(0, -1, 0);
@@ -656,8 +667,8 @@ TEST(Nclt, WithoutGroundTruthOdometryIsIdentity) {
   NcltReader reader(dir);
   EXPECT_FALSE(reader.info().has_ground_truth_poses);
   const Frame f = reader.frame(1);
-  EXPECT_FALSE(f.T_world_base_gt.has_value());
-  EXPECT_TRUE(f.T_world_base_odom.isApprox(Pose::Identity()));
+  EXPECT_FALSE(f.T_world_base.has_value());
+  EXPECT_TRUE(f.T_odom_base.isApprox(Pose::Identity()));
 }
 
 TEST(Nclt, ErrorsNameTheFile) {

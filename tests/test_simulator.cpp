@@ -59,7 +59,7 @@ TEST(Simulator, IsAStreamingFrameSourceWithGroundTruth) {
   const Frame f = source.frame(3);
   EXPECT_EQ(f.index, 3u);
   EXPECT_NEAR(f.timestamp_s, 0.6, 1e-9);
-  ASSERT_TRUE(f.T_world_base_gt.has_value());
+  ASSERT_TRUE(f.T_world_base.has_value());
   EXPECT_EQ(f.points.size(), f.point_labels.size());
   EXPECT_GT(f.points.size(), 50000u);
   ASSERT_EQ(f.cameras.size(), 3u);
@@ -80,7 +80,7 @@ TEST(Simulator, LidarAndCameraAgreeOnClasses) {
   size_t visible = 0, agree = 0;
   for (size_t index : {5, 60, 120}) {
     const Frame f = sim.frame(index);
-    const Pose T_world_lidar = *f.T_world_base_gt * rig.T_base_lidar;
+    const Pose T_world_lidar = *f.T_world_base * rig.T_base_lidar;
     for (const auto& cam : rig.cameras) {
       const CameraRender r = renderCamera(
           sim.scene(), cam, T_world_lidar * cam.T_camera_lidar.inverse(), sim.lighting(), 1, true);
@@ -131,9 +131,9 @@ TEST(Simulator, DatasetWriteReadRoundTrip) {
     const Frame a = sim.frame(i), b = reader.frame(i);
     EXPECT_TRUE(sameFrame(a, b)) << "frame " << i;
     EXPECT_NEAR(a.timestamp_s, b.timestamp_s, 1e-12);
-    ASSERT_TRUE(b.T_world_base_gt.has_value());
-    EXPECT_LT(translationError(*a.T_world_base_gt, *b.T_world_base_gt), 1e-9);
-    EXPECT_LT(translationError(a.T_world_base_odom, b.T_world_base_odom), 1e-9);
+    ASSERT_TRUE(b.T_world_base.has_value());
+    EXPECT_LT(translationError(*a.T_world_base, *b.T_world_base), 1e-9);
+    EXPECT_LT(translationError(a.T_odom_base, b.T_odom_base), 1e-9);
   }
   // A truncated LiDAR file is reported with its name.
   const auto lidar = dir / "lidar" / "000001.bin";

@@ -7,8 +7,11 @@
 #include <fstream>
 #include <random>
 
-#include "semsegmap/io/atomic_file.h"
-#include "semsegmap/localize/map_file.h"
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/binary_io.h"
+#include "semsegmap/io/map_file.h"
+#include "semsegmap/localize/localizer.h"
+#include "semsegmap/localize/target_map.h"
 
 namespace semsegmap {
 namespace {
@@ -165,4 +168,67 @@ TEST(TargetMapBuilder, ANewerSegmentReplacesADuplicateAtTheSamePlace) {
 }
 
 }  // namespace
+// ---- The localizer's map: shared when saved, its own when it grows ------------------------------
+
+// A query of `n` map segments seen from a robot 3 m east and 1 m north of the map origin.
+std::vector<Eigen::Vector3f> shiftedCentroids(const TargetMap& map, size_t n) {
+  std::vector<Eigen::Vector3f> local;
+  for (size_t i = 0; i < n; ++i)
+    local.push_back(map.segments[i].centroid - Eigen::Vector3f(3, 1, 0));
+  return local;
+}
+
+TEST(Localizer, AMapGrownSegmentBySegmentLocalizesAsTheWholeMap) {
+  const TargetMap whole = randomMap(300, 16, false);
+  const Localizer built(whole, LocalizerConfig{});
+  TargetMap empty = whole;
+  empty.segments.clear();
+  empty.descriptors.resize(0, 16);
+  Localizer grown(empty, LocalizerConfig{});
+  for (size_t start = 0; start < whole.size(); start += 70) {
+    const size_t n = std::min<size_t>(70, whole.size() - start);
+    const std::vector<MapSegment> part(whole.segments.begin() + start,
+                                       whole.segments.begin() + start + n);
+    grown.append(part, whole.descriptors.middleRows(static_cast<Eigen::Index>(start), n));
+  }
+  ASSERT_EQ(grown.map().size(), whole.size());
+  EXPECT_TRUE(grown.map().descriptors.isApprox(whole.descriptors));
+  EXPECT_EQ(grown.index().size(), whole.size());
+  const auto local = shiftedCentroids(whole, 40);
+  const Eigen::MatrixXf query = whole.descriptors.topRows(40);
+  const auto a = built.localize(local, query), b = grown.localize(local, query);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->matches, b->matches);
+  EXPECT_LT((b->T_map_local.translation() - Eigen::Vector3d(3, 1, 0)).norm(), 1e-3);
+}
+
+TEST(Localizer, ASharedMapIsNotCopiedUntilItChanges) {
+  const auto saved = std::make_shared<const TargetMap>(randomMap(50, 8, false));
+  const Localizer a(saved, LocalizerConfig{});
+  Localizer b(saved, LocalizerConfig{});
+  EXPECT_EQ(&a.map(), saved.get());
+  EXPECT_EQ(&b.map(), saved.get());
+  b.setCentroid(0, Eigen::Vector3f(1, 2, 3));  // b's own copy from now on
+  EXPECT_NE(&b.map(), saved.get());
+  EXPECT_EQ(b.map().segments[0].centroid, Eigen::Vector3f(1, 2, 3));
+  EXPECT_EQ(saved->segments[0].centroid, a.map().segments[0].centroid);
+  EXPECT_NE(saved->segments[0].centroid, Eigen::Vector3f(1, 2, 3));
+  EXPECT_THROW(b.append({MapSegment{}}, Eigen::MatrixXf::Zero(1, 5)), std::invalid_argument);
+}
+
+TEST(Localizer, GrowingPastTheExactLimitRebuildsAsIvfOnce) {
+  LocalizerConfig config;
+  config.index.exact_below = 400;
+  const TargetMap whole = randomMap(600, 8, false);
+  TargetMap first = whole;
+  first.segments.resize(300);
+  first.descriptors = whole.descriptors.topRows(300);
+  Localizer grown(first, config);
+  EXPECT_FALSE(grown.index().approximate());
+  grown.append({whole.segments.begin() + 300, whole.segments.end()},
+               whole.descriptors.bottomRows(300));
+  EXPECT_TRUE(grown.index().approximate());
+  EXPECT_EQ(grown.index().size(), 600u);
+}
+
 }  // namespace semsegmap

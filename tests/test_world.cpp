@@ -134,10 +134,10 @@ TEST(Trajectory, RunLengthsMatchThePaper) {
     const Trajectory t = makeTrajectory(fullWorld().roads, run, {}, {}, 1);
     EXPECT_NEAR(t.length_m, len, 0.1 * len) << runName(run);
     // 5 m/s at 5 Hz: about a metre between frames, never a jump.
-    for (size_t k = 1; k < t.T_world_base_gt.size(); ++k) {
-      const double step = translationError(t.T_world_base_gt[k - 1], t.T_world_base_gt[k]);
+    for (size_t k = 1; k < t.T_world_base.size(); ++k) {
+      const double step = translationError(t.T_world_base[k - 1], t.T_world_base[k]);
       ASSERT_NEAR(step, 1.0, 0.15) << runName(run) << " frame " << k;
-      ASSERT_LT(rotationErrorDeg(t.T_world_base_gt[k - 1], t.T_world_base_gt[k]), 15.0);
+      ASSERT_LT(rotationErrorDeg(t.T_world_base[k - 1], t.T_world_base[k]), 15.0);
     }
   }
 }
@@ -147,28 +147,28 @@ TEST(Trajectory, S3IsS2Reversed) {
   const Trajectory s3 = makeTrajectory(fullWorld().roads, Run::S3, {}, {}, 1);
   EXPECT_EQ(defaultCondition(Run::S3), "sunrise");
   // Every S3 pose is on S2's streets (the other lane) and heads the other way.
-  for (size_t k = 0; k < s3.T_world_base_gt.size(); k += 5) {
-    const Pose& p = s3.T_world_base_gt[k];
+  for (size_t k = 0; k < s3.T_world_base.size(); k += 5) {
+    const Pose& p = s3.T_world_base[k];
     double best = 1e9;
     size_t best_j = 0;
-    for (size_t j = 0; j < s2.T_world_base_gt.size(); ++j) {
-      const double d = translationError(p, s2.T_world_base_gt[j]);
+    for (size_t j = 0; j < s2.T_world_base.size(); ++j) {
+      const double d = translationError(p, s2.T_world_base[j]);
       if (d < best) best = d, best_j = j;
     }
     EXPECT_LT(best, 6.0) << "S3 frame " << k;
-    EXPECT_GT(rotationErrorDeg(p, s2.T_world_base_gt[best_j]), 120.0) << "S3 frame " << k;
+    EXPECT_GT(rotationErrorDeg(p, s2.T_world_base[best_j]), 120.0) << "S3 frame " << k;
   }
   // And it starts where S2 ends, roughly.
-  EXPECT_LT(translationError(s3.T_world_base_gt.front(), s2.T_world_base_gt.back()), 8.0);
+  EXPECT_LT(translationError(s3.T_world_base.front(), s2.T_world_base.back()), 8.0);
 }
 
 TEST(Trajectory, S1RevisitsPlaces) {
   const Trajectory t = makeTrajectory(fullWorld().roads, Run::S1, {}, {}, 1);
   // Count frames that come within 4 m of a frame at least 200 frames earlier.
   int revisits = 0;
-  for (size_t k = 200; k < t.T_world_base_gt.size(); ++k)
+  for (size_t k = 200; k < t.T_world_base.size(); ++k)
     for (size_t j = 0; j + 200 < k; ++j) {
-      if (translationError(t.T_world_base_gt[k], t.T_world_base_gt[j]) < 4.0) {
+      if (translationError(t.T_world_base[k], t.T_world_base[j]) < 4.0) {
         ++revisits;
         break;
       }
@@ -178,17 +178,17 @@ TEST(Trajectory, S1RevisitsPlaces) {
 
 TEST(Trajectory, OdometryDriftsAboutOnePercent) {
   const Trajectory t = makeTrajectory(fullWorld().roads, Run::S0, {}, {}, 3);
-  EXPECT_LT(translationError(t.T_world_base_gt.front(), t.T_world_base_odom.front()), 1e-12);
+  EXPECT_LT(translationError(t.T_world_base.front(), t.T_odom_base.front()), 1e-12);
   // Relative motion over 100 frames: scale error close to the configured 1 %.
   double gt_dist = 0, odom_dist = 0;
   for (size_t k = 1; k <= 100; ++k) {
-    gt_dist += translationError(t.T_world_base_gt[k - 1], t.T_world_base_gt[k]);
-    odom_dist += translationError(t.T_world_base_odom[k - 1], t.T_world_base_odom[k]);
+    gt_dist += translationError(t.T_world_base[k - 1], t.T_world_base[k]);
+    odom_dist += translationError(t.T_odom_base[k - 1], t.T_odom_base[k]);
   }
   EXPECT_NEAR(std::abs(odom_dist / gt_dist - 1.0), 0.01, 0.004);
   // Heading drifts by the configured 0.05 degrees a metre (plus a little noise).
-  const Pose rel_gt = t.T_world_base_gt[0].inverse() * t.T_world_base_gt[100];
-  const Pose rel_odom = t.T_world_base_odom[0].inverse() * t.T_world_base_odom[100];
+  const Pose rel_gt = t.T_world_base[0].inverse() * t.T_world_base[100];
+  const Pose rel_odom = t.T_odom_base[0].inverse() * t.T_odom_base[100];
   EXPECT_NEAR(rotationErrorDeg(rel_gt, rel_odom), 0.05 * gt_dist, 1.0);
 }
 

@@ -4,28 +4,41 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/dataset_writer.h"
-#include "semsegmap/io/open_dataset.h"
 
 namespace semsegmap::app {
 
-int runConvert(const std::vector<std::string>& args) {
-  const CliArgs a(args, {"dataset", "out", "max-frames"}, {});
-  auto source = openDataset(a.require("dataset"));
-  const long long max_frames = a.getInt("max-frames", 0);
-  if (max_frames < 0) throw std::invalid_argument("--max-frames must not be negative");
-  const size_t n = max_frames > 0
-                       ? std::min<size_t>(source->size(), static_cast<size_t>(max_frames))
-                       : source->size();
-  DatasetWriter writer(a.require("out"), source->info());
+namespace {
+
+int runConvert(const CliArgs& a) {
+  auto source = openDataset(a.get("dataset"));
+  const size_t n = a.frameLimit(source->size());
+  DatasetWriter writer(a.get("out"), source->info());
   Progress progress("convert", n);
   for (size_t i = 0; i < n; ++i) {
     writer.write(source->frame(i));
     progress.update(i + 1);
   }
   std::cout << "wrote " << writer.framesWritten() << " frames of " << source->info().name << " to "
-            << a.require("out") << "\n";
+            << a.get("out") << "\n";
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& convertCommand() {
+  static const CommandSpec command{
+      "convert",
+      "writes any dataset the command line reads in the project's own format",
+      {
+          {"dataset", Value::kText, "SPEC", "", "the dataset to convert", kRequired},
+          {"out", Value::kText, "DIR", "", "dataset directory to write", kRequired},
+          maxFramesOption(),
+      },
+      kDatasetNotes,
+      runConvert};
+  return command;
 }
 
 }  // namespace semsegmap::app

@@ -8,31 +8,27 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "resources.h"
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/report.h"
-#include "semsegmap/io/atomic_file.h"
 #include "semsegmap/sim/simulator.h"
 #include "semsegmap/viz/sim_overview.h"
 
 namespace semsegmap::app {
 
-int runDemo(const std::vector<std::string>& args) {
-  const CliArgs a(args, {"out", "world-seed", "preset", "max-frames", "configs"}, {});
+namespace {
+
+int runDemo(const CliArgs& a) {
   const auto start = std::chrono::steady_clock::now();
-  const std::filesystem::path out = a.get("out", "demo_out");
+  const std::filesystem::path out = a.get("out");
   std::filesystem::create_directories(out);
 
   LocalizationExperimentConfig config;
-  config.world_seed = static_cast<uint64_t>(a.getInt("world-seed", 1));
-  config.preset = a.get("preset", "small");
-  const long long max_frames = a.getInt("max-frames", 0);
-  if (max_frames < 0) throw std::invalid_argument("--max-frames must not be negative");
-  config.max_frames = static_cast<size_t>(max_frames);
-  for (const char* path : {"config/semsegmap.yaml", "config/segmap.yaml"}) {
-    if (!std::filesystem::exists(path))
-      throw std::runtime_error(std::string(path) +
-                               ": not found (run the demo from the repository's root)");
-    config.configs.push_back(loadNamedConfig(path));
-  }
+  config.world_seed = a.getCount("world-seed");
+  config.preset = a.get("preset");
+  config.max_frames = a.frameLimit();
+  for (const char* name : {"config/semsegmap.yaml", "config/segmap.yaml"})
+    config.configs.push_back(loadNamedConfig(shippedFile(name)));
 
   std::cout << "semsegmap demo: world " << config.world_seed << " (" << config.preset
             << "), map S0, localize S2 (sunny) and S3 (sunrise) with SemSegMap and SegMap\n";
@@ -45,13 +41,31 @@ int runDemo(const std::vector<std::string>& args) {
   context.title = "semsegmap demo: localization on the " + config.preset + " world " +
                   std::to_string(config.world_seed);
   context.command = "semsegmap demo";
-  for (const std::string& arg : args) context.command += " " + arg;
+  for (const std::string& arg : a.args()) context.command += " " + arg;
   context.pictures = {"overview.png"};
   context.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   writeBytesAtomically(out / "report.md", paperReport(context, nullptr, nullptr, &e));
   std::printf("wrote %s with its pictures in %.1f min\n", (out / "report.md").string().c_str(),
               context.seconds / 60.0);
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& demoCommand() {
+  static const CommandSpec command{
+      "demo",
+      "the main job: map S0, localize S2 and S3 with SemSegMap and SegMap -> report.md",
+      {
+          {"out", Value::kText, "DIR", "demo_out", "output folder: report.md and pictures"},
+          {"world-seed", Value::kCount, "N", "1", "seed of the procedural world"},
+          {"preset", Value::kText, "full|small|tiny", "small", "size of the world"},
+          maxFramesOption("stop each run after its first K frames, 0: all"),
+      },
+      "It reads the shipped config/semsegmap.yaml, config/segmap.yaml and models, from the\n"
+      "installed share/semsegmap or the source tree, wherever it is run from.\n",
+      runDemo};
+  return command;
 }
 
 }  // namespace semsegmap::app

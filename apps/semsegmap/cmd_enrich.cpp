@@ -5,34 +5,35 @@
 #include <stdexcept>
 
 #include "cli_args.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/enrich/enricher.h"
 #include "semsegmap/io/image_io.h"
-#include "semsegmap/io/open_dataset.h"
 #include "semsegmap/io/ply_writer.h"
 #include "semsegmap/viz/enrich_overlay.h"
 
 namespace semsegmap::app {
 
-int runEnrich(const std::vector<std::string>& args) {
-  const CliArgs a(args, {"dataset", "frame", "out", "ply", "camera"}, {});
-  const std::string spec = a.require("dataset");
-  const std::string out = a.require("out");
+namespace {
+
+int runEnrich(const CliArgs& a) {
+  const std::string spec = a.get("dataset");
+  const std::string out = a.get("out");
   auto source = openDataset(spec);
   const DatasetInfo& info = source->info();
 
-  const long long frame_index = a.getInt("frame", 0);
-  if (frame_index < 0 || static_cast<size_t>(frame_index) >= source->size())
-    throw std::invalid_argument("--frame " + std::to_string(frame_index) + " is outside " + spec +
-                                " (" + std::to_string(source->size()) + " frames)");
+  const size_t frame_index = a.getCount("frame");
+  if (frame_index >= source->size())
+    throw UsageError("--frame " + std::to_string(frame_index) + " is outside " + spec + " (" +
+                     std::to_string(source->size()) + " frames)");
   const size_t n_cams = info.rig.cameras.size();
   if (n_cams == 0) throw std::invalid_argument("dataset '" + spec + "' has no cameras to draw on");
   // The simulator's three cameras are left, front, right: the front one shows the most.
-  const long long camera = a.getInt("camera", n_cams == 3 ? 1 : 0);
-  if (camera < 0 || static_cast<size_t>(camera) >= n_cams)
-    throw std::invalid_argument("--camera " + std::to_string(camera) + " is outside 0.." +
-                                std::to_string(n_cams - 1));
+  const size_t camera = a.has("camera") ? a.getCount("camera") : (n_cams == 3 ? 1 : 0);
+  if (camera >= n_cams)
+    throw UsageError("--camera " + std::to_string(camera) + " is outside 0.." +
+                     std::to_string(n_cams - 1));
 
-  const Frame frame = source->frame(static_cast<size_t>(frame_index));
+  const Frame frame = source->frame(frame_index);
   if (frame.cameras.size() != n_cams || frame.cameras[camera].rgb.empty())
     throw std::invalid_argument("dataset '" + spec + "' frame " + std::to_string(frame_index) +
                                 ": camera '" + info.rig.cameras[camera].name + "' has no image");
@@ -60,10 +61,29 @@ int runEnrich(const std::vector<std::string>& args) {
   std::cout << "enriched " << cloud.size() << " points (" << coloured << " coloured) in " << ms
             << " ms\nwrote " << out << "\n";
   if (a.has("ply")) {
-    writeEnrichedPly(a.get("ply", ""), cloud);
-    std::cout << "wrote " << a.get("ply", "") << "\n";
+    writeEnrichedPly(a.get("ply"), cloud);
+    std::cout << "wrote " << a.get("ply") << "\n";
   }
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& enrichCommand() {
+  static const CommandSpec command{
+      "enrich",
+      "one frame's LiDAR points coloured from the cameras, drawn over a camera image",
+      {
+          {"dataset", Value::kText, "SPEC", "", "the dataset", kRequired},
+          {"frame", Value::kCount, "I", "0", "the frame to enrich"},
+          {"out", Value::kText, "FILE.png", "", "the camera image with the points", kRequired},
+          {"ply", Value::kText, "FILE.ply", "", "also write the enriched cloud"},
+          {"camera", Value::kCount, "K", "",
+           "the camera to draw on (default: 1, the front one, with three cameras, else 0)"},
+      },
+      kDatasetNotes,
+      runEnrich};
+  return command;
 }
 
 }  // namespace semsegmap::app

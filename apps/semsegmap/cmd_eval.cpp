@@ -8,8 +8,10 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "resources.h"
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/describe/descriptor.h"
 #include "semsegmap/eval/report.h"
-#include "semsegmap/io/atomic_file.h"
 
 namespace semsegmap::app {
 
@@ -24,101 +26,106 @@ std::vector<std::string> splitList(const std::string& s) {
   return out;
 }
 
-size_t maxFrames(const CliArgs& a) {
-  const long long n = a.getInt("max-frames", 0);
-  if (n < 0) throw std::invalid_argument("--max-frames must not be negative");
-  return static_cast<size_t>(n);
+// --query-runs: a list of runs, each one of S0..S3.
+std::vector<std::string> runList(const CliArgs& a, const std::string& name) {
+  const std::vector<std::string> runs = splitList(a.get(name));
+  for (const std::string& run : runs)
+    if (run != "S0" && run != "S1" && run != "S2" && run != "S3")
+      throw UsageError("option --" + name + ": unknown run '" + run + "' (expected S0..S3)");
+  return runs;
+}
+
+// --descriptors: a list of descriptor names, checked before any experiment starts.
+std::vector<std::string> descriptorList(const CliArgs& a) {
+  const std::vector<std::string> names = splitList(a.get("descriptors"));
+  for (const std::string& name : names) {
+    try {
+      parseDescriptorKind(name);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("option --descriptors: ") + e.what());
+    }
+  }
+  return names;
 }
 
 // The configurations compared: SemSegMap first, the SegMap baseline second.
 std::vector<NamedConfig> comparedConfigs(const CliArgs& a) {
   std::vector<NamedConfig> configs;
-  for (const std::string& path :
-       splitList(a.get("configs", "config/semsegmap.yaml,config/segmap.yaml")))
+  // The default list names shipped configs; a list the user types names their own files.
+  for (const std::string& name : splitList(a.get("configs"))) {
+    const std::filesystem::path path =
+        a.has("configs") ? std::filesystem::path(name) : shippedFile(name);
     configs.push_back(loadNamedConfig(path));
+  }
   return configs;
-}
-
-const std::set<std::string> kCommon = {"world-seed", "out", "preset", "max-frames"};
-std::set<std::string> optionsWith(std::set<std::string> extra) {
-  extra.insert(kCommon.begin(), kCommon.end());
-  return extra;
 }
 
 SegmentationExperimentConfig segmentationConfig(const CliArgs& a) {
   SegmentationExperimentConfig c;
-  c.world_seed = static_cast<uint64_t>(a.getInt("world-seed", 1));
-  c.preset = a.get("preset", "full");
-  c.run = a.get("segmentation-run", "S1");
-  c.max_frames = maxFrames(a);
+  c.world_seed = a.getCount("world-seed");
+  c.preset = a.get("preset");
+  c.run = a.get("segmentation-run");
+  c.max_frames = a.frameLimit();
   c.configs = comparedConfigs(a);
   return c;
 }
 
 DescriptorExperimentConfig descriptorConfig(const CliArgs& a) {
   DescriptorExperimentConfig c;
-  c.world_seed = static_cast<uint64_t>(a.getInt("world-seed", 1));
-  c.preset = a.get("preset", "full");
-  c.run = a.get("descriptor-run", "S0");
-  c.max_frames = maxFrames(a);
-  c.segmentation = loadNamedConfig(a.get("config", "config/semsegmap.yaml"));
-  c.models = a.get("models", "models");
-  c.descriptors = splitList(a.get("descriptors", "semsegmap-net,segmap-cnn,fpfh,eigen"));
-  c.threads = static_cast<int>(a.getInt("threads", 0));
+  c.world_seed = a.getCount("world-seed");
+  c.preset = a.get("preset");
+  c.run = a.get("descriptor-run");
+  c.max_frames = a.frameLimit();
+  c.descriptors = descriptorList(a);
+  c.segmentation = loadNamedConfig(a.getPath("config"));
+  c.models = a.getPath("models");
+  c.threads = static_cast<int>(a.getCount("threads"));
   return c;
 }
 
 LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   LocalizationExperimentConfig c;
-  c.world_seed = static_cast<uint64_t>(a.getInt("world-seed", 1));
-  c.preset = a.get("preset", "full");
-  c.map_run = a.get("map-run", "S0");
-  c.query_runs = splitList(a.get("query-runs", "S2,S3"));
-  c.max_frames = maxFrames(a);
+  c.world_seed = a.getCount("world-seed");
+  c.preset = a.get("preset");
+  c.map_run = a.get("map-run");
+  c.query_runs = runList(a, "query-runs");
+  c.max_frames = a.frameLimit();
   c.configs = comparedConfigs(a);
   return c;
 }
 
-int runEvalSegmentation(const std::vector<std::string>& args) {
-  const CliArgs a(args, optionsWith({"configs", "segmentation-run"}), {});
+int runEvalSegmentation(const CliArgs& a) {
   StageProgress progress;
   const SegmentationExperiment e =
-      runSegmentationExperiment(segmentationConfig(a), a.require("out"), std::ref(progress));
+      runSegmentationExperiment(segmentationConfig(a), a.get("out"), std::ref(progress));
   std::cout << segmentationTable(e) << "wrote "
-            << (std::filesystem::path(a.require("out")) / "segmentation.json").string()
+            << (std::filesystem::path(a.get("out")) / "segmentation.json").string()
             << ", segmentation.png\n";
   return 0;
 }
 
-int runEvalDescriptors(const std::vector<std::string>& args) {
-  const CliArgs a(
-      args, optionsWith({"config", "models", "descriptors", "threads", "descriptor-run"}), {});
+int runEvalDescriptors(const CliArgs& a) {
   StageProgress progress;
   const DescriptorExperiment e =
-      runDescriptorExperiment(descriptorConfig(a), a.require("out"), std::ref(progress));
+      runDescriptorExperiment(descriptorConfig(a), a.get("out"), std::ref(progress));
   std::cout << descriptorTable(e) << "wrote "
-            << (std::filesystem::path(a.require("out")) / "descriptors.json").string()
+            << (std::filesystem::path(a.get("out")) / "descriptors.json").string()
             << ", descriptors.png\n";
   return 0;
 }
 
-int runEvalLocalization(const std::vector<std::string>& args) {
-  const CliArgs a(args, optionsWith({"configs", "map-run", "query-runs"}), {});
+int runEvalLocalization(const CliArgs& a) {
   StageProgress progress;
   const LocalizationExperiment e =
-      runLocalizationExperiment(localizationConfig(a), a.require("out"), std::ref(progress));
+      runLocalizationExperiment(localizationConfig(a), a.get("out"), std::ref(progress));
   std::cout << localizationTable(e) << "wrote "
-            << (std::filesystem::path(a.require("out")) / "localization.json").string()
+            << (std::filesystem::path(a.get("out")) / "localization.json").string()
             << ", localization_accuracy.png and one folder per run\n";
   return 0;
 }
 
-int runEvalPaper(const std::vector<std::string>& args) {
-  const CliArgs a(args,
-                  optionsWith({"configs", "config", "models", "descriptors", "threads",
-                               "segmentation-run", "descriptor-run", "map-run", "query-runs"}),
-                  {});
-  const std::filesystem::path out = a.require("out");
+int runEvalPaper(const CliArgs& a) {
+  const std::filesystem::path out = a.get("out");
   const auto start = std::chrono::steady_clock::now();
   // Every configuration and model is read before the first experiment starts.
   const SegmentationExperimentConfig sc = segmentationConfig(a);
@@ -135,24 +142,72 @@ int runEvalPaper(const std::vector<std::string>& args) {
   context.title = "SemSegMap against SegMap: the paper's experiments on world " +
                   std::to_string(sc.world_seed) + " (" + sc.preset + ")";
   context.command = "semsegmap eval paper";
-  for (const std::string& arg : args) context.command += " " + arg;
+  for (const std::string& arg : a.args()) context.command += " " + arg;
   context.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   writeBytesAtomically(out / "report.md", paperReport(context, &s, &d, &l));
   std::cout << "wrote " << (out / "report.md").string() << "\n";
   return 0;
 }
 
+// The options of the experiments, each declared once.
+const OptionSpec kWorldSeed{"world-seed", Value::kCount, "N", "1", "seed of the procedural world"};
+const OptionSpec kOut{"out", Value::kText, "DIR", "", "output folder", kRequired};
+const OptionSpec kPreset{"preset", Value::kText, "full|small|tiny", "full", "size of the world"};
+const OptionSpec kMaxFrames = maxFramesOption("stop each run after its first K frames, 0: all");
+const OptionSpec kConfigs{
+    "configs", Value::kText, "A.yaml,B.yaml", "config/semsegmap.yaml,config/segmap.yaml",
+    "the configurations compared, SemSegMap first, the baseline second (default: the "
+    "shipped ones)"};
+const OptionSpec kSegmentationRun{"segmentation-run", Value::kText, "S0|S1|S2|S3", "S1",
+                                  "the run whose revisits are compared"};
+const OptionSpec kDescriptorRun{"descriptor-run", Value::kText, "S0|S1|S2|S3", "S0",
+                                "the run whose segments are ranked"};
+const OptionSpec kConfig{
+    "config", Value::kText, "FILE", "config/semsegmap.yaml",
+    "the configuration that cuts the descriptor run into segments (default: shipped)"};
+const OptionSpec kModels{"models", Value::kText, "DIR", "models",
+                         "folder of the learned descriptors' models (default: the shipped models)"};
+const OptionSpec kDescriptors{"descriptors", Value::kText, "LIST",
+                              "semsegmap-net,segmap-cnn,fpfh,eigen", "the descriptors compared"};
+const OptionSpec kThreads{"threads", Value::kCount, "N", "0",
+                          "threads that describe segments, 0: all cores"};
+const OptionSpec kMapRun{"map-run", Value::kText, "S0|S1|S2|S3", "S0",
+                         "the run the target map is built from"};
+const OptionSpec kQueryRuns{"query-runs", Value::kText, "LIST", "S2,S3",
+                            "the runs localized against the map"};
+
 }  // namespace
 
-int runEval(const std::vector<std::string>& args) {
-  const std::string expected = "segmentation, descriptors, localization or paper";
-  if (args.empty()) throw std::invalid_argument("eval needs an experiment: " + expected);
-  const std::vector<std::string> rest(args.begin() + 1, args.end());
-  if (args[0] == "segmentation") return runEvalSegmentation(rest);
-  if (args[0] == "descriptors") return runEvalDescriptors(rest);
-  if (args[0] == "localization") return runEvalLocalization(rest);
-  if (args[0] == "paper") return runEvalPaper(rest);
-  throw std::invalid_argument("unknown experiment '" + args[0] + "' (expected " + expected + ")");
+const std::vector<const CommandSpec*>& evalCommands() {
+  static const CommandSpec segmentation{
+      "eval segmentation",
+      "segment consistency at revisits (convex hull IoU) -> segmentation.json",
+      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kSegmentationRun},
+      "",
+      runEvalSegmentation};
+  static const CommandSpec descriptors{
+      "eval descriptors",
+      "retrieval of segments from their partial observations -> descriptors.json",
+      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfig, kModels, kDescriptors, kThreads,
+       kDescriptorRun},
+      "",
+      runEvalDescriptors};
+  static const CommandSpec localization{
+      "eval localization",
+      "maps one run, localizes the others with each config -> localization.json",
+      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kMapRun, kQueryRuns},
+      "",
+      runEvalLocalization};
+  static const CommandSpec paper{
+      "eval paper",
+      "the segmentation, descriptor and localization experiments, and report.md",
+      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kSegmentationRun, kConfig, kModels,
+       kDescriptors, kThreads, kDescriptorRun, kMapRun, kQueryRuns},
+      "",
+      runEvalPaper};
+  static const std::vector<const CommandSpec*> all = {&segmentation, &descriptors, &localization,
+                                                      &paper};
+  return all;
 }
 
 }  // namespace semsegmap::app

@@ -5,48 +5,48 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/eval/localization_picture.h"
-#include "semsegmap/io/atomic_file.h"
 #include "semsegmap/io/config.h"
-#include "semsegmap/io/open_dataset.h"
-#include "semsegmap/localize/map_file.h"
+#include "semsegmap/io/map_file.h"
+#include "semsegmap/io/model_file.h"
+#include "semsegmap/io/run_output.h"
 #include "semsegmap/pipeline/modes.h"
-#include "semsegmap/pipeline/run_output.h"
 
 namespace semsegmap::app {
 
-int runLocalize(const std::vector<std::string>& args) {
-  const CliArgs a(args, {"dataset", "config", "map", "out", "max-frames"}, {});
-  const PipelineConfig config = loadPipelineConfig(a.require("config"));
-  const std::filesystem::path map_path = a.require("map");
-  const std::filesystem::path out = a.require("out");
-  const TargetMap map = loadTargetMap(map_path);
-  auto describer = makeDescriber(config.descriptor);
-  checkMapCompatible(map_path, map, descriptorName(describer->kind()), describer->fingerprint(),
+namespace {
+
+int runLocalize(const CliArgs& a) {
+  const PipelineConfig config = loadPipelineConfig(a.get("config"));
+  const std::filesystem::path map_path = a.get("map");
+  const std::filesystem::path out = a.get("out");
+  const auto map = std::make_shared<const TargetMap>(loadTargetMap(map_path));
+  std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
+  checkMapCompatible(map_path, *map, descriptorName(describer->kind()), describer->fingerprint(),
                      describer->dimension());
-  auto source = openDataset(a.require("dataset"));
-  const long long max_frames = a.getInt("max-frames", 0);
-  if (max_frames < 0) throw std::invalid_argument("--max-frames must not be negative");
+  auto source = openDataset(a.get("dataset"));
   std::filesystem::create_directories(out);
 
   Progress progress("localize", 0);
   RunOptions options;
-  options.max_frames = static_cast<size_t>(max_frames);
+  options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
-  const LocalizationRun run = runLocalization(*source, config, map, *describer, options);
+  const LocalizationRun run = runLocalization(*source, config, map, describer, options);
 
   writeLocalizationsCsv(out / "localizations.csv", run);
   SummaryContext context;
   context.dataset = source->info().name;
   context.map = map_path.string();
-  context.config = a.require("config");
-  context.descriptor = map.descriptor;
-  context.map_segments = map.size();
+  context.config = a.get("config");
+  context.descriptor = map->descriptor;
+  context.map_segments = map->size();
   context.map_bytes = std::filesystem::file_size(map_path);
   writeBytesAtomically(out / "summary.json", localizationSummaryJson(run, context));
-  writeLocalizationPicture(out / "localization.png", run, map,
+  writeLocalizationPicture(out / "localization.png", run, *map,
                            source->info().name + " against " + map_path.filename().string() + " (" +
-                               std::filesystem::path(a.require("config")).stem().string() + ")");
+                               std::filesystem::path(a.get("config")).stem().string() + ")");
 
   const LocalizationSummary s = summarize(run.localizations);
   if (run.trajectory_gt.empty())  // errors need ground truth; zeros would read as perfect
@@ -61,6 +61,25 @@ int runLocalize(const std::vector<std::string>& args) {
   std::cout << "wrote " << (out / "localizations.csv").string()
             << ", summary.json, localization.png\n";
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& localizeCommand() {
+  static const CommandSpec command{
+      "localize",
+      "localizes a run against a target map -> localizations.csv, summary.json, .png",
+      {
+          {"dataset", Value::kText, "SPEC", "", "the run to localize", kRequired},
+          {"config", Value::kText, "FILE", "",
+           "pipeline configuration, the one the map was built with", kRequired},
+          {"map", Value::kText, "MAP", "", "the target map (semsegmap map)", kRequired},
+          {"out", Value::kText, "DIR", "", "output folder", kRequired},
+          maxFramesOption(),
+      },
+      kDatasetNotes,
+      runLocalize};
+  return command;
 }
 
 }  // namespace semsegmap::app

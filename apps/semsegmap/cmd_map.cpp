@@ -4,41 +4,44 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/config.h"
-#include "semsegmap/io/open_dataset.h"
-#include "semsegmap/localize/map_file.h"
+#include "semsegmap/io/map_file.h"
+#include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/slam.h"
 
 namespace semsegmap::app {
 
-int runMap(const std::vector<std::string>& args) {
-  const CliArgs a(args, {"dataset", "config", "out", "poses", "max-frames", "points"}, {"float32"});
-  PipelineConfig config = loadPipelineConfig(a.require("config"));
-  const std::filesystem::path out = a.require("out");
-  auto source = openDataset(a.require("dataset"));
-  const std::string poses = a.get("poses", source->info().has_ground_truth_poses ? "gt" : "odom");
-  const long long max_frames = a.getInt("max-frames", 0);
-  if (max_frames < 0) throw std::invalid_argument("--max-frames must not be negative");
-  const long long points = a.getInt("points", 0);
-  if (points < 0 || points > 65535) throw std::invalid_argument("--points must be in 0..65535");
-  config.target_map.max_points_per_segment = static_cast<size_t>(points);
-  auto describer = makeDescriber(config.descriptor);
+namespace {
+
+int runMap(const CliArgs& a) {
+  const size_t points = a.getCount("points");
+  if (points > 65535)
+    throw UsageError("option --points must be in 0..65535, got " + a.get("points"));
+  PipelineConfig config = loadPipelineConfig(a.get("config"));
+  const std::filesystem::path out = a.get("out");
+  auto source = openDataset(a.get("dataset"));
+  const std::string poses = a.has("poses")                          ? a.get("poses")
+                            : source->info().has_ground_truth_poses ? "gt"
+                                                                    : "odom";
+  config.target_map.max_points_per_segment = points;
+  std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
 
   Progress progress("map", 0);
   RunOptions options;
-  options.max_frames = static_cast<size_t>(max_frames);
+  options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   TargetMap map;
   RunStats stats;
   size_t segments = 0, duplicates = 0;
   if (poses == "slam") {
-    SlamRun run = runSlam(*source, config, *describer, options);
+    SlamRun run = runSlam(*source, config, describer, options);
     map = std::move(run.map);
     stats = run.stats;
     segments = map.size();
   } else {
-    MappingRun run = runMapping(*source, config, parsePoseSource(poses), *describer, options);
+    MappingRun run = runMapping(*source, config, parsePoseSource(poses), describer, options);
     map = std::move(run.map);
     stats = run.stats;
     segments = run.segments;
@@ -55,6 +58,27 @@ int runMap(const std::vector<std::string>& args) {
       map.size() ? static_cast<double>(bytes) / map.size() : 0.0, stats.fps());
   std::cout << "wrote " << out.string() << "\n";
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& mapCommand() {
+  static const CommandSpec command{
+      "map",
+      "builds a target map from a mapping run and saves it (docs/map-format.md)",
+      {
+          {"dataset", Value::kText, "SPEC", "", "the mapping run", kRequired},
+          {"config", Value::kText, "FILE", "", "pipeline configuration, config/*.yaml", kRequired},
+          {"out", Value::kText, "MAP", "", "the map file to write", kRequired},
+          {"poses", Value::kText, "gt|odom|slam", "",
+           "poses the map is built with (default: gt when the data has them, else odom)"},
+          maxFramesOption(),
+          {"points", Value::kCount, "N", "0", "points kept per segment for pictures, 0..65535"},
+          {"float32", Value::kFlag, "", "", "store descriptors as float32 instead of float16"},
+      },
+      kDatasetNotes,
+      runMap};
+  return command;
 }
 
 }  // namespace semsegmap::app

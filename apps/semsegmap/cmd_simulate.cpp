@@ -8,22 +8,17 @@
 
 namespace semsegmap::app {
 
-int runSimulate(const std::vector<std::string>& args) {
-  const CliArgs a(args,
-                  {"world-seed", "run", "condition", "traffic-seed", "max-frames", "world", "out"},
-                  {"no-cameras"});
+namespace {
+
+int runSimulate(const CliArgs& a) {
   sim::SimConfig config;
-  config.world =
-      sim::worldPreset(a.get("world", "full"), static_cast<uint64_t>(a.getInt("world-seed", 1)));
-  config.run = sim::parseRun(a.require("run"));
-  config.condition = a.get("condition", "");
-  if (a.has("traffic-seed"))
-    config.traffic_seed = static_cast<uint64_t>(a.getInt("traffic-seed", 1));
-  const long long max_frames = a.getInt("max-frames", 0);
-  if (max_frames < 0) throw std::invalid_argument("--max-frames must not be negative");
-  config.max_frames = static_cast<size_t>(max_frames);
+  config.world = sim::worldPreset(a.get("world"), a.getCount("world-seed"));
+  config.run = sim::parseRun(a.get("run"));
+  if (a.has("condition")) config.condition = a.get("condition");
+  if (a.has("traffic-seed")) config.traffic_seed = a.getCount("traffic-seed");
+  config.max_frames = a.frameLimit();
   config.render_cameras = !a.has("no-cameras");
-  const std::string out = a.require("out");
+  const std::string out = a.get("out");
 
   sim::Simulator simulator(config);
   DatasetWriter writer(out, simulator.info());
@@ -36,6 +31,29 @@ int runSimulate(const std::vector<std::string>& args) {
             << " m, " << simulator.lighting().name << ", traffic seed " << simulator.trafficSeed()
             << ") to " << out << "\n";
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& simulateCommand() {
+  static const CommandSpec command{
+      "simulate",
+      "renders a run of the built-in simulator into a dataset directory",
+      {
+          {"world-seed", Value::kCount, "N", "1", "seed of the procedural world"},
+          {"run", Value::kText, "S0|S1|S2|S3", "", "the run to drive", kRequired},
+          {"condition", Value::kText, "sunny|sunrise", "",
+           "lighting (default: the run's own, sunrise for S3, sunny for the others)"},
+          {"traffic-seed", Value::kCount, "M", "",
+           "seed of the parked and moving traffic (default: one per run)"},
+          maxFramesOption(),
+          {"world", Value::kText, "full|small|tiny", "full", "size of the world"},
+          {"out", Value::kText, "DIR", "", "dataset directory to write", kRequired},
+          {"no-cameras", Value::kFlag, "", "", "LiDAR only: do not render the cameras"},
+      },
+      "",
+      runSimulate};
+  return command;
 }
 
 }  // namespace semsegmap::app

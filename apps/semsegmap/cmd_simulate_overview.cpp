@@ -7,21 +7,39 @@
 
 namespace semsegmap::app {
 
-int runSimulateOverview(const std::vector<std::string>& args) {
-  const CliArgs a(args, {"world-seed", "world", "out", "cameras", "run", "frame"}, {});
-  const sim::WorldConfig world =
-      sim::worldPreset(a.get("world", "full"), static_cast<uint64_t>(a.getInt("world-seed", 1)));
-  const std::string out = a.require("out");
+namespace {
+
+int runSimulateOverview(const CliArgs& a) {
+  const sim::WorldConfig world = sim::worldPreset(a.get("world"), a.getCount("world-seed"));
+  const std::string out = a.get("out");
   viz::writeSimOverview(world, out);
   std::cout << "wrote " << out << "\n";
   if (a.has("cameras")) {
-    const long long frame = a.getInt("frame", 40);
-    if (frame < 0) throw std::invalid_argument("--frame must not be negative");
-    viz::writeCameraContactSheet(world, sim::parseRun(a.get("run", "S2")),
-                                 static_cast<size_t>(frame), a.get("cameras", ""));
-    std::cout << "wrote " << a.get("cameras", "") << "\n";
+    viz::writeCameraContactSheet(world, sim::parseRun(a.get("run")), a.getCount("frame"),
+                                 a.get("cameras"));
+    std::cout << "wrote " << a.get("cameras") << "\n";
   }
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& simulateOverviewCommand() {
+  static const CommandSpec command{
+      "simulate-overview",
+      "bird's-eye picture of a world with its runs, and a contact sheet of one frame",
+      {
+          {"world-seed", Value::kCount, "N", "1", "seed of the procedural world"},
+          {"world", Value::kText, "full|small|tiny", "full", "size of the world"},
+          {"out", Value::kText, "FILE.png", "", "the bird's-eye picture to write", kRequired},
+          {"cameras", Value::kText, "FILE.png", "",
+           "also write a contact sheet of one frame: cameras, labels and LiDAR"},
+          {"run", Value::kText, "S0|S1|S2|S3", "S2", "the run of the contact sheet"},
+          {"frame", Value::kCount, "I", "40", "the frame of the contact sheet"},
+      },
+      "",
+      runSimulateOverview};
+  return command;
 }
 
 }  // namespace semsegmap::app

@@ -10,41 +10,24 @@
 
 #include "cli_args.h"
 #include "progress.h"
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/datasets/dataset_specs.h"
 #include "semsegmap/io/config.h"
+#include "semsegmap/io/model_file.h"
+#include "semsegmap/io/training_cache.h"
 #include "semsegmap/learn/trainer.h"
 
 namespace semsegmap::app {
 
 namespace {
 
-double parsePositive(const CliArgs& a, const std::string& name, double fallback) {
-  if (!a.has(name)) return fallback;
-  const std::string text = a.get(name, "");
-  size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !(v > 0))
-    throw std::invalid_argument("--" + name + " expects a positive number, got '" + text + "'");
-  return v;
-}
-
+// A kPositive option, bounded (`fallback`, the library's default, when it is not given).
 int positiveInt(const CliArgs& a, const std::string& name, int fallback) {
-  const long long v = a.getInt(name, fallback);
-  if (v < 1 || v > 1000000) throw std::invalid_argument("--" + name + " must be at least 1");
+  if (!a.has(name)) return fallback;
+  const long long v = a.getInt(name);
+  if (v > 1000000)
+    throw UsageError("option --" + name + " must be at most 1000000, got '" + a.get(name) + "'");
   return static_cast<int>(v);
-}
-
-std::string readText(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // What the cached observations were made from: a different list, configuration or extraction
@@ -54,9 +37,7 @@ std::string provenance(const std::vector<std::string>& specs, const std::string&
   std::ostringstream s;
   s << "datasets:";
   for (const auto& spec : specs) s << ' ' << spec;
-  s << "\nmin_purity: " << e.min_purity
-    << "\nfirst_transient_instance: " << e.first_transient_instance
-    << "\nmax_frames: " << e.max_frames
+  s << "\nmin_purity: " << e.min_purity << "\nmax_frames: " << e.max_frames
     << "\nmax_points_per_observation: " << e.max_points_per_observation << "\nseed: " << e.seed
     << "\nconfig:\n"
     << config_text;
@@ -93,30 +74,33 @@ TrainingSet loadOrExtract(const std::vector<std::string>& specs, const PipelineC
   return set;
 }
 
-// One line per epoch on stderr, redrawn as the steps go, with the time left for the whole run.
+// One line per epoch on stderr as the steps go, with the time left for the whole run (redrawn
+// on a terminal, a line every tenth of an epoch or 30 s into a log).
 class EpochProgress {
  public:
   explicit EpochProgress(int epochs) : epochs_(epochs), start_(std::chrono::steady_clock::now()) {}
 
   void step(int epoch, size_t done, size_t total, double loss) {
+    if (epoch != epoch_) {
+      epoch_ = epoch;
+      line_ = ProgressLine();
+    }
     const double elapsed = seconds();
-    if (done < total && elapsed - last_ < 0.5) return;
-    last_ = elapsed;
-    const double frac = (epoch - 1 + static_cast<double>(done) / total) / epochs_;
+    const double in_epoch = total ? static_cast<double>(done) / total : 1.0;
+    if (!line_.due(in_epoch, elapsed, done >= total)) return;
+    const double frac = (epoch - 1 + in_epoch) / epochs_;
     const double left = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
-    const int width = 20, filled = static_cast<int>(static_cast<double>(done) / total * width);
-    std::fprintf(stderr, "\repoch %d/%d [%s%s] %zu/%zu  loss %.4f  %s  %.0f min left   ", epoch,
-                 epochs_, std::string(filled, '#').c_str(),
-                 std::string(width - filled, '.').c_str(), done, total, loss, validation_.c_str(),
-                 left / 60.0);
-    std::fflush(stderr);
+    char text[160];
+    std::snprintf(text, sizeof text, "epoch %d/%d %s %zu/%zu  loss %.4f  %s  %.0f min left", epoch,
+                  epochs_, progressBar(in_epoch, 20).c_str(), done, total, loss,
+                  validation_.c_str(), left / 60.0);
+    line_.write(text, done >= total);
   }
   void epoch(const EpochStats& s) {
     char text[96];
     std::snprintf(text, sizeof text, "val top1 %.3f top5 %.3f", s.validation.top1,
                   s.validation.top5);
     validation_ = text;
-    std::fprintf(stderr, "\n");
     std::printf(
         "epoch %d  loss %.4f (triplet %.4f, reconstruction %.4f)  val top1 %.3f top5 %.3f "
         "(%zu queries)  %.0f s%s\n",
@@ -131,7 +115,8 @@ class EpochProgress {
   }
   int epochs_;
   std::chrono::steady_clock::time_point start_;
-  double last_ = -1.0;
+  int epoch_ = 0;
+  ProgressLine line_;
   std::string validation_ = "val -";
 };
 
@@ -147,60 +132,50 @@ void writeHistoryCsv(const std::filesystem::path& path, const std::vector<EpochS
   });
 }
 
-}  // namespace
-
-int runTrain(const std::vector<std::string>& args) {
-  const CliArgs a(args,
-                  {"descriptor", "dataset", "out", "epochs", "threads", "config", "batch",
-                   "max-frames", "cache", "anchors-per-epoch", "lr", "seed", "points", "history"},
-                  {});
-  TrainConfig config = defaultTrainConfig(parseDescriptorKind(a.require("descriptor")));
-  const std::vector<std::string> specs = splitDatasetSpecs(a.require("dataset"));
-  const std::filesystem::path out = a.require("out");
+// The training settings from the options; what is not given keeps the library's default for
+// the descriptor (defaultTrainConfig).
+TrainConfig trainConfig(const CliArgs& a) {
+  TrainConfig config = defaultTrainConfig(parseDescriptorKind(a.get("descriptor")));
   config.epochs = positiveInt(a, "epochs", config.epochs);
   config.threads = positiveInt(a, "threads", config.threads);
   config.batch_size = positiveInt(a, "batch", config.batch_size);
-  config.learning_rate = parsePositive(a, "lr", config.learning_rate);
   config.net.num_points = positiveInt(a, "points", config.net.num_points);
-  const long long anchors = a.getInt("anchors-per-epoch", 0);
-  if (anchors < 0) throw std::invalid_argument("--anchors-per-epoch must not be negative");
-  config.anchors_per_epoch = static_cast<size_t>(anchors);
-  const long long seed = a.getInt("seed", 1);
-  if (seed < 0) throw std::invalid_argument("--seed must not be negative");
-  config.seed = static_cast<uint64_t>(seed);
-  // Checked before the long extraction, not after it.
-  if (config.net.kind != DescriptorKind::kSemSegMapNet &&
-      config.net.kind != DescriptorKind::kSegMapCnn)
-    throw std::invalid_argument("--descriptor " + a.require("descriptor") +
-                                " is not learned (expected semsegmap-net or segmap-cnn)");
-  validateNetConfig(config.net);
+  if (a.has("lr")) config.learning_rate = a.getNumber("lr");
+  if (a.has("anchors-per-epoch")) config.anchors_per_epoch = a.getCount("anchors-per-epoch");
+  if (a.has("seed")) config.seed = a.getCount("seed");
+  validateNetConfig(config.net);  // before the long extraction, not after it
+  return config;
+}
 
+int runTrain(const CliArgs& a) {
+  const TrainConfig config = trainConfig(a);
+  const std::vector<std::string> specs = splitDatasetSpecs(a.get("dataset"));
+  const std::filesystem::path out = a.get("out");
   ExtractionConfig extraction;
-  const long long max_frames = a.getInt("max-frames", 0);
-  if (max_frames < 0) throw std::invalid_argument("--max-frames must not be negative");
-  extraction.max_frames = static_cast<size_t>(max_frames);
+  extraction.max_frames = a.frameLimit();
   // Without --config, the built-in defaults (those of config/semsegmap.yaml).
   PipelineConfig pipeline;
   std::string config_text = "(defaults)";
   if (a.has("config")) {
-    pipeline = loadPipelineConfig(a.require("config"));
-    config_text = readText(a.require("config"));
+    pipeline = loadPipelineConfig(a.get("config"));
+    config_text = readFileBytes(a.get("config"));
   }
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
 
   const TrainingSet data =
-      loadOrExtract(specs, pipeline, config_text, extraction, a.get("cache", ""));
+      loadOrExtract(specs, pipeline, config_text, extraction, a.has("cache") ? a.get("cache") : "");
   EpochProgress progress(config.epochs);
   TrainCallbacks callbacks;
   callbacks.step = [&](int epoch, size_t done, size_t total, double loss) {
     progress.step(epoch, done, total, loss);
   };
   callbacks.epoch = [&](const EpochStats& s) { progress.epoch(s); };
-  const TrainResult result = trainDescriptor(data, config, out, callbacks);
+  callbacks.best = [&](DescriptorNetImpl& net) { saveNet(out, net); };
+  const TrainResult result = trainDescriptor(data, config, callbacks);
 
   if (a.has("history")) {
-    writeHistoryCsv(a.require("history"), result.history);
-    std::cout << "wrote " << a.require("history") << "\n";
+    writeHistoryCsv(a.get("history"), result.history);
+    std::cout << "wrote " << a.get("history") << "\n";
   }
   std::printf("trained on %zu observations (%zu anchors), validated on %zu\n",
               result.train_observations, result.anchors, result.validation_observations);
@@ -210,6 +185,61 @@ int runTrain(const std::vector<std::string>& args) {
   std::cout << "wrote " << out.string() << " (" << descriptorName(config.net.kind)
             << ", fingerprint " << netFingerprint(*result.net) << ")\n";
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& trainCommand() {
+  const TrainConfig net = defaultTrainConfig(DescriptorKind::kSemSegMapNet);
+  const TrainConfig cnn = defaultTrainConfig(DescriptorKind::kSegMapCnn);
+  // The library's defaults as the help shows them: one value, or one per descriptor.
+  auto shown = [&](auto field) {
+    std::ostringstream s;
+    s << "(default: " << field(net);
+    if (field(cnn) != field(net)) s << "; " << field(cnn) << " for segmap-cnn";
+    s << ")";
+    return s.str();
+  };
+  static const CommandSpec command{
+      "train",
+      "trains a learned descriptor on simulated ground truth; its best epoch -> --out",
+      {
+          {"descriptor", Value::kText, "semsegmap-net|segmap-cnn", "", "the descriptor to train",
+           kRequired},
+          {"dataset", Value::kText, "SPEC[,SPEC...]", "", "the runs to learn from", kRequired},
+          {"out", Value::kText, "FILE", "", "the model file to write", kRequired},
+          {"epochs", Value::kPositive, "N", "",
+           "epochs " + shown([](const TrainConfig& c) { return c.epochs; })},
+          {"batch", Value::kPositive, "N", "",
+           "triplets a step " + shown([](const TrainConfig& c) { return c.batch_size; })},
+          {"threads", Value::kPositive, "N", "",
+           "torch threads " + shown([](const TrainConfig& c) { return c.threads; })},
+          {"config", Value::kText, "FILE", "",
+           "pipeline configuration that cuts the runs into segments (default: built-in, as "
+           "config/semsegmap.yaml)"},
+          maxFramesOption("stop each run after its first K frames, 0: all"),
+          {"cache", Value::kText, "FILE", "",
+           "read the observations from FILE if made from the same data and settings, else "
+           "extract and write them there"},
+          {"anchors-per-epoch", Value::kCount, "N", "",
+           "anchors drawn per epoch, 0: every observation with a positive " +
+               shown([](const TrainConfig& c) { return c.anchors_per_epoch; })},
+          {"lr", Value::kNumber, "X", "",
+           "Adam's learning rate " + shown([](const TrainConfig& c) { return c.learning_rate; })},
+          {"seed", Value::kCount, "N", "",
+           "seed of weights, sampling and augmentation " +
+               shown([](const TrainConfig& c) { return c.seed; })},
+          {"points", Value::kPositive, "N", "",
+           "points a segment is subsampled to " +
+               shown([](const TrainConfig& c) { return c.net.num_points; })},
+          {"history", Value::kText, "FILE.csv", "", "also write one row per epoch"},
+      },
+      std::string("--dataset: a key=value after a sim: spec belongs to it, any other item starts a "
+                  "new spec\n(';' also separates): sim:world=1,run=S1,sim:world=1,run=S1,"
+                  "condition=sunrise\n\n") +
+          kDatasetNotes,
+      runTrain};
+  return command;
 }
 
 }  // namespace semsegmap::app

@@ -1,12 +1,62 @@
-// A one-line progress bar on stderr (only when stderr is a terminal or CI wants it).
+// Progress on stderr. On a terminal one line is redrawn in place ('\r', at most twice a second);
+// into a file or a pipe (a log) plain lines are written instead: one each time another tenth of
+// the work is done or 30 s have passed, and the final one.
 #pragma once
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
 #include <string>
 
 namespace semsegmap::app {
+
+inline bool stderrIsTerminal() {
+  return isatty(fileno(stderr)) != 0;
+}
+
+// When and how a progress line is written; the text is up to its user.
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool terminal = stderrIsTerminal()) : terminal_(terminal) {}
+
+  // Whether to write a line now: `fraction` of the work is done after `elapsed` seconds;
+  // `last` is the final update (written once, however often it is reported).
+  bool due(double fraction, double elapsed, bool last) {
+    if (finished_) return false;
+    const int tenth = static_cast<int>(fraction * 10.0);
+    bool now = last;
+    if (terminal_)
+      now |= elapsed - last_time_ >= 0.5;
+    else
+      now |= tenth > last_tenth_ || elapsed - last_time_ >= 30.0;
+    if (!now) return false;
+    last_time_ = elapsed;
+    last_tenth_ = tenth;
+    finished_ = last;
+    return true;
+  }
+  void write(const std::string& text, bool last) const {
+    if (terminal_)
+      std::fprintf(stderr, "\r%s   %s", text.c_str(), last ? "\n" : "");
+    else
+      std::fprintf(stderr, "%s\n", text.c_str());
+    std::fflush(stderr);
+  }
+
+ private:
+  bool terminal_;
+  bool finished_ = false;
+  double last_time_ = -1.0;  // the first update draws the line on a terminal
+  int last_tenth_ = 0;
+};
+
+inline std::string progressBar(double fraction, int width) {
+  const int filled = std::max(0, std::min(width, static_cast<int>(fraction * width)));
+  return "[" + std::string(filled, '#') + std::string(width - filled, '.') + "]";
+}
 
 class Progress {
  public:
@@ -18,17 +68,14 @@ class Progress {
   }
   void update(size_t done) {
     const double elapsed = seconds();
-    if (done < total_ && elapsed - last_ < 0.5) return;
-    last_ = elapsed;
     const double frac = total_ ? static_cast<double>(done) / total_ : 1.0;
-    const int width = 30;
-    const int filled = static_cast<int>(frac * width);
+    const bool last = done >= total_;
+    if (!line_.due(frac, elapsed, last)) return;
     const double left = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
-    std::fprintf(stderr, "\r%s [%s%s] %zu/%zu  %.0f s, %.0f s left   ", label_.c_str(),
-                 std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), done,
-                 total_, elapsed, left);
-    if (done >= total_) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
+    char numbers[96];
+    std::snprintf(numbers, sizeof numbers, " %zu/%zu  %.0f s, %.0f s left", done, total_, elapsed,
+                  left);
+    line_.write(label_ + " " + progressBar(frac, 30) + numbers, last);
   }
   double seconds() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -38,7 +85,7 @@ class Progress {
   std::string label_;
   size_t total_;
   std::chrono::steady_clock::time_point start_;
-  double last_ = -1.0;
+  ProgressLine line_;
 };
 
 // One bar per stage of a longer job (an ExperimentProgress): a new bar when the stage changes.

@@ -37,8 +37,11 @@ struct Frame {
   std::vector<LidarPoint> points;
   std::vector<PointLabel> point_labels;  // empty, or one per point
   std::vector<CameraFrame> cameras;      // in the order of SensorRig::cameras
-  Pose T_world_base_odom = Pose::Identity();
-  std::optional<Pose> T_world_base_gt;
+  // Poses are named T_to_from, so that subscripts cancel: T_world_lidar = T_world_base *
+  // rig.T_base_lidar. The odometry frame is where the robot's own odometry started; the world
+  // frame is the dataset's ground truth, when it has one.
+  Pose T_odom_base = Pose::Identity();
+  std::optional<Pose> T_world_base;  // ground truth
 };
 
 }  // namespace semsegmap

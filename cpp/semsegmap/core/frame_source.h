@@ -16,6 +16,9 @@ struct DatasetInfo {
   ClassTable classes = ClassTable::Default();
   bool has_ground_truth_poses = false;
   bool has_point_labels = false;
+  // Point instance ids from here on are traffic (parked and moving cars): no landmarks, and
+  // another run of the same place has other ones. 0: the dataset has no such range.
+  uint16_t first_transient_instance = 0;
 };
 
 class FrameSource {

@@ -36,13 +36,14 @@ class Describer {
   virtual Eigen::MatrixXf describe(const std::vector<DescriptorInput>& batch) = 0;
 };
 
+class DescriptorNetImpl;  // describe/learned_net.h
+
 struct DescriberOptions {
-  std::string model_path;  // required for the learned descriptors
-  int threads = 0;         // 0: all cores
+  std::shared_ptr<DescriptorNetImpl> net;  // required for the learned descriptors (loadNet)
+  int threads = 0;                         // 0: all cores
 };
 
-// Throws std::runtime_error naming the model file when it is missing, truncated or of another
-// descriptor kind.
+// Throws std::invalid_argument for a learned kind without a network or with one of another kind.
 std::unique_ptr<Describer> makeDescriber(DescriptorKind kind, const DescriberOptions& options);
 
 }  // namespace semsegmap

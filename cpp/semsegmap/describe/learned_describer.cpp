@@ -55,12 +55,12 @@ class LearnedDescriber : public Describer {
       throw std::invalid_argument("makeLearnedDescriber: " + descriptorName(kind) +
                                   " is not a learned descriptor");
     }
-    if (options.model_path.empty()) {
+    if (!options.net || options.net->config().kind != kind) {
       throw std::invalid_argument("makeLearnedDescriber: " + descriptorName(kind) +
-                                  " needs a model file (DescriberOptions::model_path)");
+                                  " needs a network of its kind (DescriberOptions::net, loadNet)");
     }
     keepFreedMemoryForTorch();
-    net_ = loadNet(options.model_path, kind);
+    net_ = options.net;
     net_->eval();
     fingerprint_ = netFingerprint(*net_);
   }

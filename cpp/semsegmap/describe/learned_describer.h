@@ -8,8 +8,8 @@
 
 namespace semsegmap {
 
-// Loads options.model_path (throws std::runtime_error naming the file when it is missing,
-// corrupt or holds another kind; std::invalid_argument for a hand-made kind). The describer
+// Describes with options.net (std::invalid_argument for a hand-made kind or a missing network or
+// one of another kind); the describer puts the network into eval mode. The describer
 // splits a batch into chunks of at most kLearnedChunk segments for options.threads threads of
 // its own (0: all cores), each running torch single-threaded (eval mode, no autograd), and
 // subsamples every segment with the same fixed salt: a segment always gets the same

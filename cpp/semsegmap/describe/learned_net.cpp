@@ -46,7 +46,14 @@ void validateNetConfig(const NetConfig& config) {
   requireRange("descriptor_dim", config.descriptor_dim, 1, 4096);
   // Set abstraction takes num_points / 4 and / 16 centres.
   requireRange("num_points", config.num_points, 64, 1 << 16);
-  requireMultiple("num_points", config.num_points, 16);
+  requireRange("sa1_divisor", config.sa1_divisor, 1, 64);
+  requireRange("sa2_divisor", config.sa2_divisor, config.sa1_divisor, 1024);
+  requireMultiple("num_points", config.num_points, config.sa2_divisor);
+  requireMultiple("num_points", config.num_points, config.sa1_divisor);
+  requireRange("sa_neighbours", config.sa_neighbours, 1, 256);
+  if (!(config.sa1_radius > 0.0f && config.sa1_radius < 10.0f && config.sa2_radius > 0.0f &&
+        config.sa2_radius < 10.0f))
+    throw std::invalid_argument("NetConfig.sa1_radius/sa2_radius: expected 0 < radius < 10");
   requireRange("num_classes", config.num_classes, 1, 1024);
   // segmap-cnn halves the grid three times.
   requireRange("grid_xy", config.grid_xy, 8, 256);

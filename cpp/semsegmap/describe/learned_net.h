@@ -8,34 +8,15 @@
 #include <torch/torch.h>
 
 #include <cstdint>
-#include <filesystem>
-#include <optional>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "semsegmap/core/enriched_point.h"
 #include "semsegmap/describe/descriptor.h"
+#include "semsegmap/describe/net_config.h"
 
 namespace semsegmap {
-
-struct NetConfig {
-  DescriptorKind kind = DescriptorKind::kSemSegMapNet;
-  int descriptor_dim = 64;
-  int num_points = 512;  // semsegmap-net: random subsample (paper: 2048; semsegmap_net.h)
-  int num_classes = 16;  // class ids >= this count into the last bin
-  int grid_xy = 32;      // segmap-cnn occupancy grid
-  int grid_z = 16;
-  int recon_grid = 16;  // decoder output: recon_grid^3 occupancy (semsegmap-net)
-  // Channels of the first layer; the later ones are multiples (semsegmap_net.h, segmap_cnn.h).
-  // Chosen for the inference budget on a 2-core CPU (bench/bench_describe.cpp).
-  int pointnet_width = 16;  // semsegmap-net
-  int cnn_width = 32;       // segmap-cnn: SegMap's 32, 64, 64
-};
-
-// Throws std::invalid_argument naming the field when a value is out of range (e.g. a grid size
-// the decoder cannot reach by doubling).
-void validateNetConfig(const NetConfig& config);
 
 // Everything the networks take, made from segment points. Built by makeNetInput, consumed by
 // forward(); `target_occupancy` is what the decoder is trained to reproduce.
@@ -80,12 +61,11 @@ torch::Tensor tripletLoss(const torch::Tensor& anchor, const torch::Tensor& posi
                           const torch::Tensor& negative, const torch::Tensor& sigma,
                           double margin = 0.4);
 
-// Model files: a header (magic, format version, descriptor kind, NetConfig, fingerprint) and
-// the weights. load throws std::runtime_error naming the file when it is missing, truncated,
-// corrupt or of another kind than `expected` (when given).
-void saveNet(const std::filesystem::path& path, DescriptorNetImpl& net);
-std::shared_ptr<DescriptorNetImpl> loadNet(const std::filesystem::path& path,
-                                           std::optional<DescriptorKind> expected = std::nullopt);
+// The plain value of a trained network (io/model_file.h reads and writes it): modelOf copies
+// the weights out, netFromModel builds the network of model.config and copies them in, checking
+// every name and shape and the fingerprint (std::runtime_error saying what does not match).
+Model modelOf(DescriptorNetImpl& net);
+std::shared_ptr<DescriptorNetImpl> netFromModel(const Model& model);
 // Fingerprint of the weights (hex of a hash over every parameter and buffer), and of the
 // NetConfig, which changes the descriptors of the same weights (num_points) too.
 std::string netFingerprint(DescriptorNetImpl& net);

@@ -106,8 +106,10 @@ SemSegMapNetImpl::SemSegMapNetImpl(const NetConfig& config) : config_(config) {
   validateNetConfig(config_);
   const int w = config_.pointnet_width;
   const int n = config_.num_points;
-  sa1_ = {n / 4, 0.2f, 16, register_module("sa1", pointwiseMlp({6, w, w, 2 * w}))};
-  sa2_ = {n / 16, 0.4f, 16, register_module("sa2", pointwiseMlp({2 * w + 3, 2 * w, 2 * w, 4 * w}))};
+  sa1_ = {n / config_.sa1_divisor, config_.sa1_radius, config_.sa_neighbours,
+          register_module("sa1", pointwiseMlp({6, w, w, 2 * w}))};
+  sa2_ = {n / config_.sa2_divisor, config_.sa2_radius, config_.sa_neighbours,
+          register_module("sa2", pointwiseMlp({2 * w + 3, 2 * w, 2 * w, 4 * w}))};
   sa3_ = {0, 0.0f, 0, register_module("sa3", pointwiseMlp({4 * w + 3, 4 * w, 8 * w}))};
 
   class_cnn_ = register_module(

@@ -19,6 +19,7 @@ torch::Tensor convOnOneDnn(torch::nn::Conv3dImpl& conv, const torch::Tensor& x);
 // Widths with w = NetConfig::pointnet_width and N = num_points (features: xyz + 3 colour):
 //   SA1  N/4 centres, radius 0.2, 16 neighbours, shared MLP 6 -> w -> w -> 2w, max
 //   SA2  N/16 centres, radius 0.4, 16 neighbours, MLP 2w+3 -> 2w -> 2w -> 4w, max
+//   (the defaults of NetConfig::sa1_divisor, sa1_radius, sa2_divisor, sa2_radius, sa_neighbours)
 //   SA3  all points, MLP 4w+3 -> 4w -> 8w, max                                    -> 8w
 //   classes  conv 1^3 C -> w, conv 2^3 -> 2w (2^3 cells), conv 2^3 -> 4w (1 cell)  -> 4w
 //   scale    log(scale / 1 m), linear 1 -> w                                       -> w

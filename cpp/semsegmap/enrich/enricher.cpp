@@ -143,25 +143,13 @@ void rgbToHsv(uint8_t r, uint8_t g, uint8_t b, float& h, float& s, float& v) {
   if (h >= 1.0f) h = 0.0f;
 }
 
-EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
-                          const EnrichmentConfig& config) {
-  checkInputs(frame, rig);
-  if (config.occlusion_radius_px < 0)
-    throw std::invalid_argument("enrichment: occlusion_radius_px must not be negative, got " +
-                                std::to_string(config.occlusion_radius_px));
+namespace {
 
-  const auto n = static_cast<std::ptrdiff_t>(frame.points.size());
-  const size_t n_cams = frame.cameras.size();  // 0 when the frame has no images at all
-
-  bool camera_semantics = false;
-  for (const auto& cf : frame.cameras) camera_semantics |= !cf.label.empty();
-  const bool point_semantics = !camera_semantics && !frame.point_labels.empty();
-
-  // Pass 1: project every point into every camera (each camera's own extrinsics).
+// Pass 1: every point into every camera (each camera's own extrinsics).
+void projectPoints(const Frame& frame, const SensorRig& rig, std::vector<CameraView>& views) {
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  std::vector<CameraView>& views = scratchViews();
-  if (views.size() < n_cams) views.resize(n_cams);
-  for (size_t c = 0; c < n_cams; ++c) views[c].points.resize(frame.points.size());
+  const auto n = static_cast<std::ptrdiff_t>(frame.points.size());
+  const size_t n_cams = frame.cameras.size();
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     const LidarPoint& lp = frame.points[i];
@@ -183,8 +171,12 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
       pr.vl = uvl ? static_cast<float>(uvl->y()) : kNaN;
     }
   }
+}
 
-  // Z-buffers: the nearest point per pixel, one camera per thread.
+// Z-buffers: the nearest point per pixel, one camera per thread.
+void fillZBuffers(const SensorRig& rig, size_t n_points, std::vector<CameraView>& views,
+                  size_t n_cams) {
+  const auto n = static_cast<std::ptrdiff_t>(n_points);
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_cams); ++c) {
     CameraView& view = views[c];
@@ -198,8 +190,55 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
       view.nearest_depth[pr.pixel] = pr.depth;
     }
   }
+}
 
-  // Pass 2: per point, the unoccluded camera whose image centre is nearest gives colour and class.
+// The unoccluded camera whose image centre is nearest to point i, and its pixel; -1 for none.
+int bestCamera(const Frame& frame, const SensorRig& rig, const std::vector<CameraView>& views,
+               size_t i, const EnrichmentConfig& config, size_t& best_pixel) {
+  int best_cam = -1;
+  double best_centre_dist = std::numeric_limits<double>::infinity();
+  for (size_t c = 0; c < frame.cameras.size(); ++c) {
+    const Projection& pr = views[c].points[i];
+    if (pr.pixel < 0) continue;
+    const CameraFrame& cf = frame.cameras[c];
+    if (cf.rgb.empty() && cf.label.empty()) continue;  // this camera has nothing to give
+    const PinholeCamera& cam = rig.cameras[c];
+    if (occluded(views[c], cam, i, config)) continue;
+    // Distance to the image centre, relative to the half diagonal, so that cameras of
+    // different sizes compare fairly; lens effects are smallest near the centre.
+    const double du = pr.u - 0.5 * cam.width, dv = pr.v - 0.5 * cam.height;
+    const double d = (du * du + dv * dv) / (0.25 * (static_cast<double>(cam.width) * cam.width +
+                                                    static_cast<double>(cam.height) * cam.height));
+    if (d < best_centre_dist) {
+      best_centre_dist = d;
+      best_cam = static_cast<int>(c);
+      best_pixel = static_cast<size_t>(pr.pixel);
+    }
+  }
+  return best_cam;
+}
+
+}  // namespace
+
+EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
+                          const EnrichmentConfig& config) {
+  checkInputs(frame, rig);
+  if (config.occlusion_radius_px < 0)
+    throw std::invalid_argument("enrichment: occlusion_radius_px must not be negative, got " +
+                                std::to_string(config.occlusion_radius_px));
+  const auto n = static_cast<std::ptrdiff_t>(frame.points.size());
+  const size_t n_cams = frame.cameras.size();  // 0 when the frame has no images at all
+  bool camera_semantics = false;
+  for (const auto& cf : frame.cameras) camera_semantics |= !cf.label.empty();
+  const bool point_semantics = !camera_semantics && !frame.point_labels.empty();
+
+  std::vector<CameraView>& views = scratchViews();
+  if (views.size() < n_cams) views.resize(n_cams);
+  for (size_t c = 0; c < n_cams; ++c) views[c].points.resize(frame.points.size());
+  projectPoints(frame, rig, views);
+  fillZBuffers(rig, frame.points.size(), views, n_cams);
+
+  // Pass 2: per point, the best camera gives colour and class.
   EnrichedCloud cloud(frame.points.size());
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t i = 0; i < n; ++i) {
@@ -212,37 +251,16 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
       ep.instance_id = frame.point_labels[i].instance_id;
       if (point_semantics) ep.class_id = frame.point_labels[i].class_id;
     }
-
-    int best_cam = -1;
-    size_t best_pixel = 0;
-    double best_centre_dist = std::numeric_limits<double>::infinity();
-    for (size_t c = 0; c < n_cams; ++c) {
-      const Projection& pr = views[c].points[i];
-      if (pr.pixel < 0) continue;
-      const CameraFrame& cf = frame.cameras[c];
-      if (cf.rgb.empty() && cf.label.empty()) continue;  // this camera has nothing to give
-      const PinholeCamera& cam = rig.cameras[c];
-      if (occluded(views[c], cam, static_cast<size_t>(i), config)) continue;
-      // Distance to the image centre, relative to the half diagonal, so that cameras of
-      // different sizes compare fairly; lens effects are smallest near the centre.
-      const double du = pr.u - 0.5 * cam.width, dv = pr.v - 0.5 * cam.height;
-      const double d =
-          (du * du + dv * dv) / (0.25 * (static_cast<double>(cam.width) * cam.width +
-                                         static_cast<double>(cam.height) * cam.height));
-      if (d < best_centre_dist) {
-        best_centre_dist = d;
-        best_cam = static_cast<int>(c);
-        best_pixel = static_cast<size_t>(pr.pixel);
-      }
-    }
-    if (best_cam < 0) continue;
-    const CameraFrame& cf = frame.cameras[best_cam];
+    size_t pixel = 0;
+    const int cam = bestCamera(frame, rig, views, static_cast<size_t>(i), config, pixel);
+    if (cam < 0) continue;
+    const CameraFrame& cf = frame.cameras[cam];
     if (!cf.rgb.empty()) {
-      const uint8_t* rgb = cf.rgb.data.data() + best_pixel * 3;
+      const uint8_t* rgb = cf.rgb.data.data() + pixel * 3;
       rgbToHsv(rgb[0], rgb[1], rgb[2], ep.h, ep.s, ep.v);
       ep.has_color = true;
     }
-    if (camera_semantics && !cf.label.empty()) ep.class_id = cf.label.data[best_pixel];
+    if (camera_semantics && !cf.label.empty()) ep.class_id = cf.label.data[pixel];
   }
   return cloud;
 }

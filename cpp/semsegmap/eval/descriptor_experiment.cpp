@@ -4,25 +4,49 @@
 #include <memory>
 #include <sstream>
 
-#include "semsegmap/io/atomic_file.h"
-#include "semsegmap/io/json.h"
+#include "semsegmap/datasets/dataset_specs.h"
+#include "semsegmap/io/model_file.h"
 #include "semsegmap/viz/plot.h"
 
 namespace semsegmap {
 
-DescriptorExperiment runDescriptorExperiment(const DescriptorExperimentConfig& cfg,
-                                             const std::filesystem::path& out,
-                                             const ExperimentProgress& progress) {
+namespace {
+
+// One panel per completeness band, one curve per descriptor: the paper's retrieval figure.
+std::vector<viz::Panel> retrievalPanels(const DescriptorExperiment& e) {
+  std::vector<viz::Panel> panels(e.bands.size());
+  for (size_t b = 0; b < e.bands.size(); ++b) {
+    panels[b].title = "completeness " + e.bands[b].name;
+    panels[b].xlabel = "k (nearest target descriptors)";
+    panels[b].ylabel = "fraction of true matches within k";
+    panels[b].log_x = true;
+    for (const DescriptorRetrieval& r : e.results) {
+      viz::Series series;
+      series.name = r.descriptor;
+      for (int k = 0; k < e.config.max_k; ++k) {
+        series.x.push_back(k + 1);
+        series.y.push_back(r.band_curves[b][static_cast<size_t>(k)]);
+      }
+      panels[b].series.push_back(std::move(series));
+    }
+  }
+  return panels;
+}
+
+}  // namespace
+
+DescriptorExperiment evaluateDescriptors(const DescriptorExperimentConfig& cfg,
+                                         const ExperimentProgress& progress) {
   DescriptorExperiment e;
   e.config = cfg;
   e.dataset = simulatedRunSpec(cfg.world_seed, cfg.run, cfg.preset);
-  DescriberOptions options;
-  options.threads = cfg.threads;
   // Load every model first: a missing one should fail before minutes of simulation.
   std::vector<std::unique_ptr<Describer>> describers;
   for (const std::string& name : cfg.descriptors) {
-    options.model_path = (cfg.models / (name + ".model")).string();
-    describers.push_back(makeDescriber(parseDescriptorKind(name), options));
+    DescriptorConfig descriptor;
+    descriptor.kind = name;
+    descriptor.model = (cfg.models / (name + ".model")).string();  // read by the learned kinds
+    describers.push_back(makeDescriber(descriptor, cfg.threads));
   }
 
   ExtractionConfig extraction;
@@ -37,54 +61,46 @@ DescriptorExperiment runDescriptorExperiment(const DescriptorExperimentConfig& c
   e.segments = q.targets.size();
   e.queries = q.queries.size();
   e.bands = defaultCompletenessBands();
-
-  std::ostringstream json;
-  json << "{\n  \"dataset\": " << jsonQuoted(e.dataset) << ",\n  \"segments\": " << e.segments
-       << ",\n  \"queries\": " << e.queries << ",\n  \"bands\": [";
-  for (size_t b = 0; b < e.bands.size(); ++b)
-    json << (b ? ", " : "") << jsonQuoted(e.bands[b].name);
-  json << "],\n  \"descriptors\": [\n";
-  // One panel per completeness band, one curve per descriptor: the paper's retrieval figure.
-  std::vector<viz::Panel> panels(e.bands.size());
-  for (size_t b = 0; b < e.bands.size(); ++b) {
-    panels[b].title = "completeness " + e.bands[b].name;
-    panels[b].xlabel = "k (nearest target descriptors)";
-    panels[b].ylabel = "fraction of true matches within k";
-    panels[b].log_x = true;
-  }
   for (size_t d = 0; d < describers.size(); ++d) {
     if (progress) progress("describe", d, describers.size());
-    DescriptorRetrieval r = evaluateRetrieval(*describers[d], set, q, e.bands, cfg.max_k);
-    for (size_t b = 0; b < e.bands.size(); ++b) {
-      viz::Series series;
-      series.name = r.descriptor;
-      for (int k = 0; k < cfg.max_k; ++k) {
-        series.x.push_back(k + 1);
-        series.y.push_back(r.band_curves[b][static_cast<size_t>(k)]);
-      }
-      panels[b].series.push_back(std::move(series));
-    }
-    json << "    {\"name\": " << jsonQuoted(r.descriptor) << ", \"top1\": " << r.top1
-         << ", \"top16\": " << r.top16 << ", \"segments_per_second\": " << r.segments_per_second
-         << ", \"band_counts\": [";
-    for (size_t b = 0; b < e.bands.size(); ++b) json << (b ? ", " : "") << r.band_counts[b];
-    json << "], \"band_curves\": [";
-    for (size_t b = 0; b < e.bands.size(); ++b) {
-      json << (b ? ", " : "") << "[";
-      for (int k = 0; k < cfg.max_k; ++k) json << (k ? ", " : "") << r.band_curves[b][k];
-      json << "]";
-    }
-    json << "]}" << (d + 1 < describers.size() ? "," : "") << "\n";
-    e.results.push_back(std::move(r));
+    e.results.push_back(evaluateRetrieval(*describers[d], set, q, e.bands, cfg.max_k));
   }
   if (progress) progress("describe", describers.size(), describers.size());
-  json << "  ]\n}\n";
+  return e;
+}
+
+nlohmann::ordered_json toJson(const DescriptorExperiment& e) {
+  nlohmann::ordered_json j;
+  j["dataset"] = e.dataset;
+  j["segments"] = e.segments;
+  j["queries"] = e.queries;
+  j["bands"] = nlohmann::ordered_json::array();
+  for (const CompletenessBand& b : e.bands) j["bands"].push_back(b.name);
+  j["descriptors"] = nlohmann::ordered_json::array();
+  for (const DescriptorRetrieval& r : e.results)
+    j["descriptors"].push_back({{"name", r.descriptor},
+                                {"top1", r.top1},
+                                {"top16", r.top16},
+                                {"segments_per_second", r.segments_per_second},
+                                {"band_counts", r.band_counts},
+                                {"band_curves", r.band_curves}});
+  return j;
+}
+
+void writeDescriptorFiles(const DescriptorExperiment& e, const std::filesystem::path& out) {
   std::filesystem::create_directories(out);
-  writeBytesAtomically(out / "descriptors.json", json.str());
+  writeJsonAtomically(out / "descriptors.json", toJson(e));
   viz::plotPanels(out / "descriptors.png",
                   "Descriptor retrieval on " + e.dataset + " (" + std::to_string(e.queries) +
                       " partial observations of " + std::to_string(e.segments) + " segments)",
-                  panels);
+                  retrievalPanels(e));
+}
+
+DescriptorExperiment runDescriptorExperiment(const DescriptorExperimentConfig& cfg,
+                                             const std::filesystem::path& out,
+                                             const ExperimentProgress& progress) {
+  DescriptorExperiment e = evaluateDescriptors(cfg, progress);
+  writeDescriptorFiles(e, out);
   return e;
 }
 

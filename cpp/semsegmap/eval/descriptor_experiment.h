@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "semsegmap/core/json.h"
 #include "semsegmap/eval/descriptor_eval.h"
 #include "semsegmap/eval/experiment.h"
 
@@ -32,7 +33,17 @@ struct DescriptorExperiment {
   std::vector<DescriptorRetrieval> results;
 };
 
+// Segments the run and ranks the observations with every descriptor; writes nothing.
+DescriptorExperiment evaluateDescriptors(const DescriptorExperimentConfig& config,
+                                         const ExperimentProgress& progress = {});
+
+// descriptors.json: every number, the retrieval curves per band included.
+nlohmann::ordered_json toJson(const DescriptorExperiment& e);
+
 // Writes descriptors.json and descriptors.png (one panel per completeness band) into `out`.
+void writeDescriptorFiles(const DescriptorExperiment& e, const std::filesystem::path& out);
+
+// evaluateDescriptors, then writeDescriptorFiles.
 DescriptorExperiment runDescriptorExperiment(const DescriptorExperimentConfig& config,
                                              const std::filesystem::path& out,
                                              const ExperimentProgress& progress = {});

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "semsegmap/core/json.h"
 #include "semsegmap/eval/experiment.h"
 #include "semsegmap/pipeline/modes.h"
 
@@ -37,8 +38,9 @@ struct LocalizationResult {  // one configuration on one query run
   StageTimes per_frame;     // mean stage times
   size_t map_segments = 0;
   uint64_t map_bytes = 0;
-  std::vector<double> errors;  // translation error of each localization, m
-  std::filesystem::path dir;   // its files, relative to the output directory
+  std::vector<double> errors;      // translation error of each localization, m
+  std::vector<size_t> cumulative;  // localizations within each of the experiment's thresholds
+  std::filesystem::path dir;       // its files, relative to the output directory
 };
 
 struct LocalizationExperiment {
@@ -47,9 +49,21 @@ struct LocalizationExperiment {
   std::vector<double> thresholds;           // of the cumulative curves, m
 };
 
-// Writes into `out`: maps/<config>.map, <config>_<run>/ (localizations.csv, summary.json,
-// localization.png), localization.json with every number, and localization_accuracy.png (the
-// cumulative number of localizations against the error threshold, one panel per query run).
+// Maps the map run and localizes the query runs with every configuration. What each run leaves
+// behind is written into `out` as the run finishes (a run's records are not kept):
+// maps/<config>.map and <config>_<run>/ (localizations.csv, summary.json, localization.png).
+LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& config,
+                                            const std::filesystem::path& out,
+                                            const ExperimentProgress& progress = {});
+
+// localization.json: the configuration and every number of every run.
+nlohmann::ordered_json toJson(const LocalizationExperiment& e);
+
+// Writes into `out` localization.json and localization_accuracy.png (the cumulative number of
+// localizations against the error threshold, one panel per query run).
+void writeLocalizationFiles(const LocalizationExperiment& e, const std::filesystem::path& out);
+
+// evaluateLocalization, then writeLocalizationFiles.
 LocalizationExperiment runLocalizationExperiment(const LocalizationExperimentConfig& config,
                                                  const std::filesystem::path& out,
                                                  const ExperimentProgress& progress = {});

@@ -15,12 +15,12 @@ void writeLocalizationPicture(const std::filesystem::path& png, const Localizati
   pic.trajectory = run.trajectory_gt.empty() ? run.trajectory_odom : run.trajectory_gt;
   const LocalizationRecord* best = nullptr;
   for (const LocalizationRecord& r : run.localizations) {
-    pic.localizations.emplace_back(r.T_map_robot.translation(),
-                                   r.T_map_robot_gt ? r.translation_error_m : -1.0);
+    pic.localizations.emplace_back(r.T_map_base.translation(),
+                                   r.T_world_base ? r.translation_error_m : -1.0);
     if (!best || r.inliers > best->inliers) best = &r;
   }
   if (best) {
-    pic.highlight = best->T_map_robot.translation();
+    pic.highlight = best->T_map_base.translation();
     pic.matches = best->matches;
   }
   viz::writeLocalizationPng(png, pic);

@@ -92,59 +92,57 @@ std::string machineDescription() {
   return m.str();
 }
 
-std::string paperReport(const ReportContext& c, const SegmentationExperiment* segmentation,
-                        const DescriptorExperiment* descriptors,
-                        const LocalizationExperiment* localization) {
-  std::ostringstream r;
-  r << "# " << c.title << "\n\n"
-    << "Made by `" << c.command << "` in " << fixed(c.seconds / 60.0, 1) << " min, commit "
-    << sourceCommit() << ", on " << machineDescription() << ".\n\n"
-    << "The simulated world is not the paper's, so the paper's numbers are a reference for the "
-       "direction and size of the differences, not for the counts themselves. SemSegMap and the "
-       "SegMap baseline always run on the very same frames.\n\n";
-  for (const std::string& p : c.pictures) r << "![" << p << "](" << p << ")\n\n";
+namespace {
 
-  if (segmentation) {
-    const SegmentationExperiment& e = *segmentation;
-    r << "## Segmentation consistency (paper IV-B)\n\n"
-      << "On " << e.config.run << " (world " << e.config.world_seed << ", " << e.config.preset
-      << "), every segment seen where the robot had been before is compared with the segments "
-         "of the earlier visit by convex hull IoU (exact, qhull); IoU >= "
-      << e.config.consistent_iou << " is a consistent re-segmentation.\n\n"
-      << segmentationTable(e) << "\n![segmentation](segmentation.png)\n\n";
-    if (e.results.size() >= 2)
-      r << "- " << e.results[0].config << " has " << fixed(e.consistent_change_pct, 1)
-        << " % consistent and " << fixed(e.inconsistent_change_pct, 1)
-        << " % inconsistent segments relative to " << e.results[1].config
-        << " (the paper: +30.97 % and -24.24 %).\n\n";
-  }
-  if (descriptors) {
-    const DescriptorExperiment& e = *descriptors;
-    r << "## Descriptor retrieval (paper IV-C)\n\n"
-      << "On " << e.dataset << ": " << e.queries << " partial observations of " << e.segments
-      << " segments, each ranked against the final observations of all segments.\n\n"
-      << descriptorTable(e) << "\n![descriptors](descriptors.png)\n\n";
-  }
-  if (localization) {
-    const LocalizationExperiment& e = *localization;
-    r << "## Localization (paper IV-D, Table I)\n\n"
-      << "Target map from " << e.config.map_run << " on ground-truth poses; the query runs "
-      << "localize on their own odometry every frame. Wrong: error > " << e.config.wrong_m
-      << " m. Recall: the fraction of metres driven after which the robot had a localization "
-         "within "
-      << e.config.correct_m << " m in the last " << e.config.recall_window_m
-      << " m. Hz: the whole pipeline per frame on this machine, rendering excluded; both "
-         "configurations' pipelines alternate on every frame next to the renderer, so this is "
-         "below what one pipeline alone reaches (the README's benchmarks). Paper: the paper's "
-         "Table I count for the same run and method.\n\n"
-      << localizationTable(e) << "\n"
-      << localizationVerdict(e) << "\n"
-      << "![accuracy](localization_accuracy.png)\n\n";
-    for (const LocalizationResult& res : e.results)
-      r << "![" << res.dir.string() << "](" << res.dir.string() << "/localization.png)\n";
-    r << "\n";
-  }
-  // Each configuration once, with the descriptor model its results came from when known.
+std::string segmentationSection(const SegmentationExperiment& e) {
+  std::ostringstream r;
+  r << "## Segmentation consistency (paper IV-B)\n\n"
+    << "On " << e.config.run << " (world " << e.config.world_seed << ", " << e.config.preset
+    << "), every segment seen where the robot had been before is compared with the segments "
+       "of the earlier visit by convex hull IoU (exact, qhull); IoU >= "
+    << e.config.consistent_iou << " is a consistent re-segmentation.\n\n"
+    << segmentationTable(e) << "\n![segmentation](segmentation.png)\n\n";
+  if (e.results.size() >= 2)
+    r << "- " << e.results[0].config << " has " << fixed(e.consistent_change_pct, 1)
+      << " % consistent and " << fixed(e.inconsistent_change_pct, 1)
+      << " % inconsistent segments relative to " << e.results[1].config
+      << " (the paper: +30.97 % and -24.24 %).\n\n";
+  return r.str();
+}
+
+std::string descriptorSection(const DescriptorExperiment& e) {
+  std::ostringstream r;
+  r << "## Descriptor retrieval (paper IV-C)\n\n"
+    << "On " << e.dataset << ": " << e.queries << " partial observations of " << e.segments
+    << " segments, each ranked against the final observations of all segments.\n\n"
+    << descriptorTable(e) << "\n![descriptors](descriptors.png)\n\n";
+  return r.str();
+}
+
+std::string localizationSection(const LocalizationExperiment& e) {
+  std::ostringstream r;
+  r << "## Localization (paper IV-D, Table I)\n\n"
+    << "Target map from " << e.config.map_run << " on ground-truth poses; the query runs "
+    << "localize on their own odometry every frame. Wrong: error > " << e.config.wrong_m
+    << " m. Recall: the fraction of metres driven after which the robot had a localization "
+       "within "
+    << e.config.correct_m << " m in the last " << e.config.recall_window_m
+    << " m. Hz: the whole pipeline per frame on this machine, rendering excluded; both "
+       "configurations' pipelines alternate on every frame next to the renderer, so this is "
+       "below what one pipeline alone reaches (the README's benchmarks). Paper: the paper's "
+       "Table I count for the same run and method.\n\n"
+    << localizationTable(e) << "\n"
+    << localizationVerdict(e) << "\n"
+    << "![accuracy](localization_accuracy.png)\n\n";
+  for (const LocalizationResult& res : e.results)
+    r << "![" << res.dir.string() << "](" << res.dir.string() << "/localization.png)\n";
+  r << "\n";
+  return r.str();
+}
+
+// Each configuration once, with the descriptor model its results came from when known.
+std::string configurationsSection(const SegmentationExperiment* segmentation,
+                                  const LocalizationExperiment* localization) {
   std::map<std::string, std::string> configs;
   if (segmentation)
     for (const NamedConfig& n : segmentation->config.configs) configs[n.path.string()] = "";
@@ -157,11 +155,31 @@ std::string paperReport(const ReportContext& c, const SegmentationExperiment* se
               (n.config.descriptor.model.empty() ? ""
                                                  : ", model " + n.config.descriptor.model +
                                                        " (fingerprint " + res.fingerprint + ")");
-  if (!configs.empty()) {
-    r << "## Configurations and models\n\n";
-    for (const auto& [path, what] : configs) r << "- " << path << what << "\n";
-    r << "\nEvery number above is also in the JSON files beside this report.\n";
-  }
+  if (configs.empty()) return "";
+  std::ostringstream r;
+  r << "## Configurations and models\n\n";
+  for (const auto& [path, what] : configs) r << "- " << path << what << "\n";
+  r << "\nEvery number above is also in the JSON files beside this report.\n";
+  return r.str();
+}
+
+}  // namespace
+
+std::string paperReport(const ReportContext& c, const SegmentationExperiment* segmentation,
+                        const DescriptorExperiment* descriptors,
+                        const LocalizationExperiment* localization) {
+  std::ostringstream r;
+  r << "# " << c.title << "\n\n"
+    << "Made by `" << c.command << "` in " << fixed(c.seconds / 60.0, 1) << " min, commit "
+    << sourceCommit() << ", on " << machineDescription() << ".\n\n"
+    << "The simulated world is not the paper's, so the paper's numbers are a reference for the "
+       "direction and size of the differences, not for the counts themselves. SemSegMap and the "
+       "SegMap baseline always run on the very same frames.\n\n";
+  for (const std::string& p : c.pictures) r << "![" << p << "](" << p << ")\n\n";
+  if (segmentation) r << segmentationSection(*segmentation);
+  if (descriptors) r << descriptorSection(*descriptors);
+  if (localization) r << localizationSection(*localization);
+  r << configurationsSection(segmentation, localization);
   return r.str();
 }
 

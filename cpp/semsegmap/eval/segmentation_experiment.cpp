@@ -7,11 +7,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/eval/convex_hull.h"
 #include "semsegmap/eval/localization_metrics.h"
-#include "semsegmap/io/atomic_file.h"
-#include "semsegmap/io/json.h"
-#include "semsegmap/io/open_dataset.h"
 #include "semsegmap/pipeline/pipeline.h"
 #include "semsegmap/viz/plot.h"
 
@@ -63,6 +61,59 @@ std::vector<double> revisitIous(const std::vector<FinishedSegment>& segments,
   return ious;
 }
 
+// What the run leaves: each configuration's finished segments, and the ground-truth trajectory.
+struct SegmentedRun {
+  std::vector<std::vector<FinishedSegment>> finished;  // per configuration
+  std::vector<Pose> trajectory;                        // one pose per frame
+};
+
+SegmentedRun segmentRun(const SegmentationExperimentConfig& cfg,
+                        const ExperimentProgress& progress) {
+  auto source = openDataset(simulatedRunSpec(cfg.world_seed, cfg.run, cfg.preset, cfg.max_frames));
+  std::vector<std::unique_ptr<Pipeline>> pipelines;
+  for (const NamedConfig& c : cfg.configs)
+    pipelines.push_back(
+        std::make_unique<Pipeline>(c.config, source->info(), PoseSource::kGroundTruth));
+  SegmentedRun run;
+  run.finished.resize(cfg.configs.size());
+  forEachFrame(*source, "segment " + cfg.run, progress, [&](const Frame& frame) {
+    for (size_t c = 0; c < pipelines.size(); ++c)
+      for (const Segment& s : pipelines[c]->process(frame).segmentation.finished)
+        run.finished[c].push_back(finishedSegment(s));
+    run.trajectory.push_back(*frame.T_world_base);
+  });
+  for (size_t c = 0; c < pipelines.size(); ++c)
+    for (const Segment& s : pipelines[c]->finish()) run.finished[c].push_back(finishedSegment(s));
+  return run;
+}
+
+SegmentationResult resultOf(const std::string& config, const std::vector<FinishedSegment>& finished,
+                            const std::vector<Pose>& trajectory,
+                            const std::vector<double>& travelled,
+                            const SegmentationExperimentConfig& cfg) {
+  SegmentationResult r;
+  r.config = config;
+  r.segments = finished.size();
+  r.ious = revisitIous(finished, trajectory, travelled, cfg);
+  r.revisit_segments = r.ious.size();
+  r.histogram = iouHistogram(r.ious, cfg.bins);
+  for (double v : r.ious) (v >= cfg.consistent_iou ? r.consistent : r.inconsistent)++;
+  return r;
+}
+
+// The first configuration against the second.
+void compareFirstTwo(SegmentationExperiment& e) {
+  if (e.results.size() < 2) return;
+  const SegmentationResult &a = e.results[0], &b = e.results[1];
+  for (int k = 0; k < e.config.bins; ++k)
+    e.bin_change_pct.push_back(relativeChangePct(static_cast<double>(a.histogram[k]),
+                                                 static_cast<double>(b.histogram[k])));
+  e.consistent_change_pct =
+      relativeChangePct(static_cast<double>(a.consistent), static_cast<double>(b.consistent));
+  e.inconsistent_change_pct =
+      relativeChangePct(static_cast<double>(a.inconsistent), static_cast<double>(b.inconsistent));
+}
+
 viz::Panel barPanel(const std::string& title, const std::string& ylabel) {
   viz::Panel p;
   p.title = title;
@@ -77,6 +128,37 @@ std::vector<double> binCentres(int bins) {
   std::vector<double> x;
   for (int b = 0; b < bins; ++b) x.push_back((b + 0.5) / bins);
   return x;
+}
+
+// The paper's figure: the histograms side by side, then the change per bin.
+std::vector<viz::Panel> segmentationPanels(const SegmentationExperiment& e) {
+  std::vector<viz::Panel> panels;
+  viz::Panel hist = barPanel("segments per IoU bin at revisits", "segments");
+  hist.auto_y = false;  // counts start at 0
+  hist.y_max = 1.0;
+  for (const SegmentationResult& r : e.results)
+    for (size_t v : r.histogram) hist.y_max = std::max(hist.y_max, 1.15 * static_cast<double>(v));
+  for (const SegmentationResult& r : e.results) {
+    viz::Series s;
+    s.name = r.config;
+    s.x = binCentres(e.config.bins);
+    for (size_t v : r.histogram) s.y.push_back(static_cast<double>(v));
+    hist.series.push_back(std::move(s));
+  }
+  panels.push_back(std::move(hist));
+  if (e.results.size() >= 2) {
+    viz::Panel change = barPanel(e.results[0].config + " against " + e.results[1].config +
+                                     " (numbers: " + e.results[0].config + "'s segments)",
+                                 "change in segments per bin (%)");
+    viz::Series s;
+    s.name = "change";
+    s.x = binCentres(e.config.bins);
+    s.y = e.bin_change_pct;
+    for (size_t v : e.results[0].histogram) s.labels.push_back(std::to_string(v));
+    change.series.push_back(std::move(s));
+    panels.push_back(std::move(change));
+  }
+  return panels;
 }
 
 }  // namespace
@@ -95,104 +177,61 @@ double relativeChangePct(double a, double b) {
   return b > 0.0 ? 100.0 * (a - b) / b : 0.0;
 }
 
-SegmentationExperiment runSegmentationExperiment(const SegmentationExperimentConfig& cfg,
-                                                 const std::filesystem::path& out,
-                                                 const ExperimentProgress& progress) {
+SegmentationExperiment evaluateSegmentation(const SegmentationExperimentConfig& cfg,
+                                            const ExperimentProgress& progress) {
   if (cfg.configs.empty())
     throw std::invalid_argument("the segmentation experiment needs at least one configuration");
   SegmentationExperiment e;
   e.config = cfg;
-  auto source = openDataset(simulatedRunSpec(cfg.world_seed, cfg.run, cfg.preset, cfg.max_frames));
-  std::vector<std::unique_ptr<Pipeline>> pipelines;
-  for (const NamedConfig& c : cfg.configs)
-    pipelines.push_back(
-        std::make_unique<Pipeline>(c.config, source->info(), PoseSource::kGroundTruth));
-  std::vector<std::vector<FinishedSegment>> finished(cfg.configs.size());
-  std::vector<Pose> trajectory;  // ground truth, one pose per frame
-  forEachFrame(*source, "segment " + cfg.run, progress, [&](const Frame& frame) {
-    for (size_t c = 0; c < pipelines.size(); ++c)
-      for (const Segment& s : pipelines[c]->process(frame).segmentation.finished)
-        finished[c].push_back(finishedSegment(s));
-    trajectory.push_back(*frame.T_world_base_gt);
-  });
-  const std::vector<double> travelled = travelledDistances(trajectory);
-
-  for (size_t c = 0; c < pipelines.size(); ++c) {
-    for (const Segment& s : pipelines[c]->finish()) finished[c].push_back(finishedSegment(s));
-    SegmentationResult r;
-    r.config = cfg.configs[c].name;
-    r.segments = finished[c].size();
-    r.ious = revisitIous(finished[c], trajectory, travelled, cfg);
-    r.revisit_segments = r.ious.size();
-    r.histogram = iouHistogram(r.ious, cfg.bins);
-    for (double v : r.ious) (v >= cfg.consistent_iou ? r.consistent : r.inconsistent)++;
-    e.results.push_back(std::move(r));
-    if (progress) progress("convex hulls", c + 1, pipelines.size());
+  const SegmentedRun run = segmentRun(cfg, progress);
+  e.frames = run.trajectory.size();
+  const std::vector<double> travelled = travelledDistances(run.trajectory);
+  for (size_t c = 0; c < cfg.configs.size(); ++c) {
+    e.results.push_back(
+        resultOf(cfg.configs[c].name, run.finished[c], run.trajectory, travelled, cfg));
+    if (progress) progress("convex hulls", c + 1, cfg.configs.size());
   }
-  if (e.results.size() >= 2) {
-    const SegmentationResult &a = e.results[0], &b = e.results[1];
-    for (int k = 0; k < cfg.bins; ++k)
-      e.bin_change_pct.push_back(relativeChangePct(static_cast<double>(a.histogram[k]),
-                                                   static_cast<double>(b.histogram[k])));
-    e.consistent_change_pct =
-        relativeChangePct(static_cast<double>(a.consistent), static_cast<double>(b.consistent));
-    e.inconsistent_change_pct =
-        relativeChangePct(static_cast<double>(a.inconsistent), static_cast<double>(b.inconsistent));
-  }
+  compareFirstTwo(e);
+  return e;
+}
 
-  // JSON with every number, then the paper's figure: the histograms and the change per bin.
-  std::ostringstream j;
-  j << "{\n  \"world_seed\": " << cfg.world_seed << ",\n  \"preset\": " << jsonQuoted(cfg.preset)
-    << ",\n  \"run\": " << jsonQuoted(cfg.run) << ",\n  \"frames\": " << trajectory.size()
-    << ",\n  \"consistent_iou\": " << cfg.consistent_iou << ",\n  \"bins\": " << cfg.bins
-    << ",\n  \"results\": [\n";
-  for (size_t c = 0; c < e.results.size(); ++c) {
-    const SegmentationResult& r = e.results[c];
-    j << "    {\"config\": " << jsonQuoted(r.config) << ", \"segments\": " << r.segments
-      << ", \"revisit_segments\": " << r.revisit_segments << ", \"consistent\": " << r.consistent
-      << ", \"inconsistent\": " << r.inconsistent << ", \"histogram\": [";
-    for (size_t k = 0; k < r.histogram.size(); ++k) j << (k ? ", " : "") << r.histogram[k];
-    j << "]}" << (c + 1 < e.results.size() ? "," : "") << "\n";
-  }
-  j << "  ],\n  \"bin_change_pct\": [";
-  for (size_t k = 0; k < e.bin_change_pct.size(); ++k) j << (k ? ", " : "") << e.bin_change_pct[k];
-  j << "],\n  \"consistent_change_pct\": " << e.consistent_change_pct
-    << ",\n  \"inconsistent_change_pct\": " << e.inconsistent_change_pct
-    << ",\n  \"paper\": {\"consistent_change_pct\": 30.97, \"inconsistent_change_pct\": "
-       "-24.24}\n}\n";
-  std::filesystem::create_directories(out);
-  writeBytesAtomically(out / "segmentation.json", j.str());
-
-  std::vector<viz::Panel> panels;
-  viz::Panel hist = barPanel("segments per IoU bin at revisits", "segments");
-  hist.auto_y = false;  // counts start at 0
-  hist.y_max = 1.0;
+nlohmann::ordered_json toJson(const SegmentationExperiment& e) {
+  nlohmann::ordered_json j;
+  j["world_seed"] = e.config.world_seed;
+  j["preset"] = e.config.preset;
+  j["run"] = e.config.run;
+  j["frames"] = e.frames;
+  j["consistent_iou"] = e.config.consistent_iou;
+  j["bins"] = e.config.bins;
+  j["results"] = nlohmann::ordered_json::array();
   for (const SegmentationResult& r : e.results)
-    for (size_t v : r.histogram) hist.y_max = std::max(hist.y_max, 1.15 * static_cast<double>(v));
-  for (const SegmentationResult& r : e.results) {
-    viz::Series s;
-    s.name = r.config;
-    s.x = binCentres(cfg.bins);
-    for (size_t v : r.histogram) s.y.push_back(static_cast<double>(v));
-    hist.series.push_back(std::move(s));
-  }
-  panels.push_back(std::move(hist));
-  if (e.results.size() >= 2) {
-    viz::Panel change = barPanel(e.results[0].config + " against " + e.results[1].config +
-                                     " (numbers: " + e.results[0].config + "'s segments)",
-                                 "change in segments per bin (%)");
-    viz::Series s;
-    s.name = "change";
-    s.x = binCentres(cfg.bins);
-    s.y = e.bin_change_pct;
-    for (size_t v : e.results[0].histogram) s.labels.push_back(std::to_string(v));
-    change.series.push_back(std::move(s));
-    panels.push_back(std::move(change));
-  }
+    j["results"].push_back({{"config", r.config},
+                            {"segments", r.segments},
+                            {"revisit_segments", r.revisit_segments},
+                            {"consistent", r.consistent},
+                            {"inconsistent", r.inconsistent},
+                            {"histogram", r.histogram}});
+  j["bin_change_pct"] = e.bin_change_pct;
+  j["consistent_change_pct"] = e.consistent_change_pct;
+  j["inconsistent_change_pct"] = e.inconsistent_change_pct;
+  j["paper"] = {{"consistent_change_pct", 30.97}, {"inconsistent_change_pct", -24.24}};
+  return j;
+}
+
+void writeSegmentationFiles(const SegmentationExperiment& e, const std::filesystem::path& out) {
+  std::filesystem::create_directories(out);
+  writeJsonAtomically(out / "segmentation.json", toJson(e));
   viz::plotPanels(out / "segmentation.png",
-                  "Segmentation consistency on " + cfg.run + " (world " +
-                      std::to_string(cfg.world_seed) + ", " + cfg.preset + ")",
-                  panels);
+                  "Segmentation consistency on " + e.config.run + " (world " +
+                      std::to_string(e.config.world_seed) + ", " + e.config.preset + ")",
+                  segmentationPanels(e));
+}
+
+SegmentationExperiment runSegmentationExperiment(const SegmentationExperimentConfig& cfg,
+                                                 const std::filesystem::path& out,
+                                                 const ExperimentProgress& progress) {
+  SegmentationExperiment e = evaluateSegmentation(cfg, progress);
+  writeSegmentationFiles(e, out);
   return e;
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "semsegmap/core/json.h"
 #include "semsegmap/eval/experiment.h"
 
 namespace semsegmap {
@@ -40,6 +41,7 @@ struct SegmentationResult {
 
 struct SegmentationExperiment {
   SegmentationExperimentConfig config;
+  size_t frames = 0;  // of the run
   std::vector<SegmentationResult> results;
   // First configuration against the second, in percent of the second's counts (0 when it has
   // none): per bin, consistent and inconsistent. The paper: +30.97 % and -24.24 %.
@@ -52,7 +54,17 @@ std::vector<size_t> iouHistogram(const std::vector<double>& ious, int bins);
 // (a - b) / b in percent; 0 when b is 0.
 double relativeChangePct(double a, double b);
 
+// Segments the run with every configuration and compares them; writes nothing.
+SegmentationExperiment evaluateSegmentation(const SegmentationExperimentConfig& config,
+                                            const ExperimentProgress& progress = {});
+
+// segmentation.json: every number, and the paper's.
+nlohmann::ordered_json toJson(const SegmentationExperiment& e);
+
 // Writes segmentation.json and segmentation.png (histograms and the change per bin) into `out`.
+void writeSegmentationFiles(const SegmentationExperiment& e, const std::filesystem::path& out);
+
+// evaluateSegmentation, then writeSegmentationFiles.
 SegmentationExperiment runSegmentationExperiment(const SegmentationExperimentConfig& config,
                                                  const std::filesystem::path& out,
                                                  const ExperimentProgress& progress = {});

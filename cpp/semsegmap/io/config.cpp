@@ -112,10 +112,10 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
   readSection(path, root, "loop_closure",
               {{"exclude_recent_m", set(lc.exclude_recent_m)},
                {"min_travel_between_loops_m", set(lc.min_travel_between_loops_m)},
-               {"odometry_translation_sigma_m", set(lc.odometry_translation_sigma_m)},
-               {"odometry_rotation_sigma_rad", set(lc.odometry_rotation_sigma_rad)},
-               {"loop_translation_sigma_m", set(lc.loop_translation_sigma_m)},
-               {"loop_rotation_sigma_rad", set(lc.loop_rotation_sigma_rad)}});
+               {"odometry_translation_sigma_m", set(lc.graph.odometry_translation_sigma_m)},
+               {"odometry_rotation_sigma_rad", set(lc.graph.odometry_rotation_sigma_rad)},
+               {"loop_translation_sigma_m", set(lc.graph.loop_translation_sigma_m)},
+               {"loop_rotation_sigma_rad", set(lc.graph.loop_rotation_sigma_rad)}});
 
   auto check = [&](bool ok, const std::string& what) {
     if (!ok) throw std::runtime_error(path.string() + ": " + what);

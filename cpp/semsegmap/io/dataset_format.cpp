@@ -13,7 +13,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 
 namespace semsegmap {
 namespace fs = std::filesystem;
@@ -265,6 +265,8 @@ void writeMetaYaml(const fs::path& path, const DatasetInfo& info) {
   emitDouble(out, path, "rate_hz", rig.rate_hz);
   out << YAML::Key << "has_ground_truth_poses" << YAML::Value << info.has_ground_truth_poses;
   out << YAML::Key << "has_point_labels" << YAML::Value << info.has_point_labels;
+  if (info.first_transient_instance > 0)
+    out << YAML::Key << "first_transient_instance" << YAML::Value << info.first_transient_instance;
 
   out << YAML::Key << "lidar" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "columns" << YAML::Value << lidar.columns;
@@ -345,13 +347,16 @@ DatasetInfo readMetaYaml(const fs::path& path) {
            std::to_string(kDatasetFormatVersion));
   p.checkKeys(root, "",
               {"format_version", "name", "rate_hz", "has_ground_truth_poses", "has_point_labels",
-               "lidar", "cameras", "classes"});
+               "first_transient_instance", "lidar", "cameras", "classes"});
 
   DatasetInfo info;
   info.name = p.text(root, "", "name");
   info.rig.rate_hz = p.number(root, "", "rate_hz");
   info.has_ground_truth_poses = p.flag(root, "", "has_ground_truth_poses");
   info.has_point_labels = p.flag(root, "", "has_point_labels");
+  if (root["first_transient_instance"])  // optional: datasets without traffic ids lack it
+    info.first_transient_instance = static_cast<uint16_t>(
+        p.integer(root, "", "first_transient_instance", 0, std::numeric_limits<uint16_t>::max()));
   info.rig.lidar = parseLidar(p, p.child(root, "", "lidar"), info.rig.T_base_lidar);
 
   const YAML::Node cameras = p.child(root, "", "cameras");

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/io/dataset_format.h"
 #include "semsegmap/io/image_io.h"
 
@@ -150,8 +150,8 @@ Frame DatasetReader::frame(size_t i) {
   Frame frame;
   frame.index = row.index;
   frame.timestamp_s = row.timestamp_s;
-  frame.T_world_base_odom = row.odom;
-  frame.T_world_base_gt = row.gt;
+  frame.T_odom_base = row.odom;
+  frame.T_world_base = row.gt;
 
   const fs::path lidar_path = dir_ / "lidar" / frameFileName(row.index, "bin");
   requireFile(lidar_path);

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/io/dataset_format.h"
 #include "semsegmap/io/image_io.h"
 
@@ -118,7 +118,7 @@ void DatasetWriter::write(const Frame& frame) {
     reject(csv, "index does not follow the previous frame's " + std::to_string(*last_index_) +
                     "; indices must increase");
   if (!std::isfinite(frame.timestamp_s)) reject(csv, "timestamp is not finite");
-  if (frame.T_world_base_gt && !info_.has_ground_truth_poses)
+  if (frame.T_world_base && !info_.has_ground_truth_poses)
     reject(csv, "has a ground-truth pose but DatasetInfo::has_ground_truth_poses is false");
   const fs::path label_path = dir_ / "lidar_gt" / name;
   if (info_.has_point_labels) {
@@ -156,9 +156,9 @@ void DatasetWriter::write(const Frame& frame) {
     }
   }
   std::string row = std::to_string(frame.index) + "," + formatExactDouble(frame.timestamp_s) +
-                    csvPose(csv, frame.index, "odometry", frame.T_world_base_odom);
-  row += frame.T_world_base_gt ? csvPose(csv, frame.index, "ground-truth", *frame.T_world_base_gt)
-                               : std::string(",,,,,,,");
+                    csvPose(csv, frame.index, "odometry", frame.T_odom_base);
+  row += frame.T_world_base ? csvPose(csv, frame.index, "ground-truth", *frame.T_world_base)
+                            : std::string(",,,,,,,");
 
   if (first) {
     for (size_t k = 0; k < n_cameras; ++k) {

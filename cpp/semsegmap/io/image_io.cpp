@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 
 namespace semsegmap {
 namespace {

@@ -202,8 +202,8 @@ Frame KittiRawReader::frame(size_t index) {
 
   if (has_oxts_) {
     const Pose T_world_lidar = oxtsPose(files.oxts);
-    f.T_world_base_gt = T_world_lidar;
-    f.T_world_base_odom = T_world_lidar;  // KITTI raw has no separate odometry
+    f.T_world_base = T_world_lidar;
+    f.T_odom_base = T_world_lidar;  // KITTI raw has no separate odometry
   }
   return f;
 }

@@ -211,8 +211,8 @@ Frame NcltReader::frame(size_t index) {
     p.z = metres(b + 4);
     p.intensity = static_cast<float>(b[6]) / 255.0f;
   }
-  f.T_world_base_odom = files.odom;
-  f.T_world_base_gt = files.gt;
+  f.T_odom_base = files.odom;
+  f.T_world_base = files.gt;
   return f;
 }
 

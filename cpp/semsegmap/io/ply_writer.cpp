@@ -5,7 +5,7 @@
 #include <cstring>
 #include <string>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 
 namespace semsegmap {
 

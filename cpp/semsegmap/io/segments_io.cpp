@@ -4,7 +4,7 @@
 #include <iomanip>
 #include <ostream>
 
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/io/ply_writer.h"
 
 namespace semsegmap {

@@ -186,8 +186,8 @@ Frame SemanticKittiReader::frame(size_t index) {
     for (PointLabel& l : f.point_labels) l.class_id = semanticKittiToClass(l.class_id);
   }
   if (files.T_world_lidar) {
-    f.T_world_base_gt = *files.T_world_lidar;
-    f.T_world_base_odom = *files.T_world_lidar;
+    f.T_world_base = *files.T_world_lidar;
+    f.T_odom_base = *files.T_world_lidar;
   }
   return f;
 }

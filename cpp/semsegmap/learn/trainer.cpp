@@ -200,12 +200,147 @@ double evaluateTriplets(DescriptorNetImpl& net, const TrainingSet& data,
   return mean.value();
 }
 
+namespace {
+
+// Descriptors of the training observations as last computed (during training, so at most an
+// epoch old and augmented): the hard-negative miner ranks candidates by them for free.
+class DescriptorCache {
+ public:
+  DescriptorCache(size_t observations, int dim)
+      : dim_(dim), rows_(static_cast<Eigen::Index>(observations), dim), cached_(observations, 0) {}
+  bool has(size_t i) const { return cached_[i] != 0; }
+  float distance(size_t a, size_t b) const {
+    return has(b)
+               ? (rows_.row(static_cast<Eigen::Index>(b)) - rows_.row(static_cast<Eigen::Index>(a)))
+                     .squaredNorm()
+               : std::numeric_limits<float>::infinity();
+  }
+  // `descriptors` [3B, D]: the anchors, positives and negatives of `triplets`.
+  void store(const torch::Tensor& descriptors, const std::vector<Triplet>& triplets) {
+    const torch::Tensor d = descriptors.detach().to(torch::kFloat).contiguous();
+    const float* dp = d.data_ptr<float>();
+    const size_t batch = triplets.size();
+    for (size_t r = 0; r < 3 * batch; ++r) {
+      const Triplet& t = triplets[r % batch];
+      const size_t i = r < batch ? t.anchor : r < 2 * batch ? t.positive : t.negative;
+      rows_.row(static_cast<Eigen::Index>(i)) =
+          Eigen::Map<const Eigen::RowVectorXf>(dp + r * static_cast<size_t>(dim_), dim_);
+      cached_[i] = 1;
+    }
+  }
+
+ private:
+  int dim_;
+  Eigen::MatrixXf rows_;
+  std::vector<char> cached_;
+};
+
+// One training run: the sampling of triplets, the steps of an epoch, and its validation.
+class Training {
+ public:
+  Training(const TrainingSet& data, const TrainConfig& config, const TrainValSplit& split,
+           const PairSampler& sampler)
+      : data_(data),
+        config_(config),
+        split_(split),
+        sampler_(sampler),
+        rng_(static_cast<uint32_t>(config.seed)),
+        net_(makeNet(config.net)),
+        optimizer_(net_->parameters(), torch::optim::AdamOptions(config.learning_rate)),
+        cache_(data.observations.size(), config.net.descriptor_dim),
+        batch_(std::min<size_t>(static_cast<size_t>(config.batch_size), sampler.anchors().size())),
+        learning_rate_(config.learning_rate) {
+    net_->train();
+    const size_t anchors_per_epoch =
+        config.anchors_per_epoch > 0 ? config.anchors_per_epoch : sampler.anchors().size();
+    steps_ = std::max<size_t>(1, anchors_per_epoch / batch_);
+  }
+
+  EpochStats epoch(int epoch, const TrainCallbacks& callbacks) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool mine = epoch > config_.warmup_epochs;
+    Mean loss_mean, triplet_mean, recon_mean;
+    for (size_t step = 0; step < steps_; ++step) {
+      const std::vector<Triplet> triplets = sampleTriplets(mine);
+      const BatchLoss b = batchLoss(*net_, data_, triplets, config_, config_.augment, rng_);
+      const torch::Tensor loss = b.triplet + config_.reconstruction_weight * b.reconstruction;
+      optimizer_.zero_grad();
+      loss.backward();
+      optimizer_.step();
+      cache_.store(b.descriptors, triplets);
+      loss_mean.add(loss.item<double>());
+      triplet_mean.add(b.triplet.item<double>());
+      recon_mean.add(b.reconstruction.item<double>());
+      if (callbacks.step) callbacks.step(epoch, step + 1, steps_, loss_mean.value());
+    }
+    EpochStats stats;
+    stats.epoch = epoch;
+    stats.loss = loss_mean.value();
+    stats.triplet_loss = triplet_mean.value();
+    stats.reconstruction_loss = recon_mean.value();
+    stats.learning_rate = learning_rate_;
+    stats.validation =
+        validationAccuracy(*net_, data_, split_.validation, config_.seed,
+                           config_.max_validation_queries, config_.validation_min_completeness);
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return stats;
+  }
+
+  void decayLearningRate() {
+    learning_rate_ *= config_.learning_rate_decay;
+    for (auto& group : optimizer_.param_groups())
+      static_cast<torch::optim::AdamOptions&>(group.options()).lr(learning_rate_);
+  }
+  DescriptorNetImpl& net() { return *net_; }
+  std::shared_ptr<DescriptorNetImpl> sharedNet() { return net_; }
+
+ private:
+  // A batch of triplets: random negatives during warm-up, then the hardest of a few candidates
+  // by the cached descriptors.
+  std::vector<Triplet> sampleTriplets(bool mine) {
+    std::vector<Triplet> triplets(batch_);
+    for (Triplet& t : triplets) {
+      if (order_.empty()) {
+        order_ = sampler_.anchors();
+        std::shuffle(order_.begin(), order_.end(), rng_);
+      }
+      t.anchor = order_.back();
+      order_.pop_back();
+      t.positive = sampler_.positive(t.anchor, rng_);
+      if (data_.observations[t.positive].n_points > data_.observations[t.anchor].n_points)
+        std::swap(t.anchor, t.positive);
+      t.negative = sampler_.negative(t.anchor, rng_);
+      if (!mine || !cache_.has(t.anchor)) continue;
+      float hardest = cache_.distance(t.anchor, t.negative);
+      for (int k = 1; k < config_.hard_negative_candidates; ++k) {
+        const size_t c = sampler_.negative(t.anchor, rng_);
+        const float d = cache_.distance(t.anchor, c);
+        if (d < hardest) hardest = d, t.negative = c;
+      }
+    }
+    return triplets;
+  }
+
+  const TrainingSet& data_;
+  const TrainConfig& config_;
+  const TrainValSplit& split_;
+  const PairSampler& sampler_;
+  std::mt19937 rng_;
+  std::shared_ptr<DescriptorNetImpl> net_;
+  torch::optim::Adam optimizer_;
+  DescriptorCache cache_;
+  size_t batch_, steps_ = 1;
+  std::vector<size_t> order_;  // anchors still to visit; refilled and shuffled when empty
+  double learning_rate_;
+};
+
+}  // namespace
+
 TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
-                            const std::filesystem::path& out, const TrainCallbacks& callbacks) {
+                            const TrainCallbacks& callbacks) {
   checkConfig(config);
   torch::set_num_threads(config.threads);
   torch::manual_seed(config.seed);
-  std::mt19937 rng(static_cast<uint32_t>(config.seed));
 
   TrainResult result;
   const TrainValSplit split = splitByInstance(data, config.validation_fraction, config.split_seed);
@@ -217,107 +352,26 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
     throw std::runtime_error(
         "training data has no instance observed twice: nothing to learn from (more frames?)");
 
-  auto net = makeNet(config.net);
-  net->train();
-  torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(config.learning_rate));
-  double learning_rate = config.learning_rate;
-
-  // Descriptors of the training observations as last computed (during training, so at most an
-  // epoch old and augmented): the hard-negative miner ranks candidates by them for free.
-  const int dim = config.net.descriptor_dim;
-  Eigen::MatrixXf cached(static_cast<Eigen::Index>(data.observations.size()), dim);
-  std::vector<char> is_cached(data.observations.size(), 0);
-  auto cachedDistance = [&](size_t a, size_t b) {
-    return is_cached[b] ? (cached.row(static_cast<Eigen::Index>(b)) -
-                           cached.row(static_cast<Eigen::Index>(a)))
-                              .squaredNorm()
-                        : std::numeric_limits<float>::infinity();
-  };
-
-  const size_t batch =
-      std::min<size_t>(static_cast<size_t>(config.batch_size), sampler.anchors().size());
-  const size_t anchors_per_epoch =
-      config.anchors_per_epoch > 0 ? config.anchors_per_epoch : sampler.anchors().size();
-  const size_t steps = std::max<size_t>(1, anchors_per_epoch / batch);
-  std::vector<size_t> order;  // anchors still to visit; refilled and shuffled when empty
-
+  Training training(data, config, split, sampler);
   Snapshot best;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int epoch = 1; epoch <= config.epochs; ++epoch) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const bool mine = epoch > config.warmup_epochs;
-    Mean loss_mean, triplet_mean, recon_mean;
-    for (size_t step = 0; step < steps; ++step) {
-      std::vector<Triplet> triplets(batch);
-      for (Triplet& t : triplets) {
-        if (order.empty()) {
-          order = sampler.anchors();
-          std::shuffle(order.begin(), order.end(), rng);
-        }
-        t.anchor = order.back();
-        order.pop_back();
-        t.positive = sampler.positive(t.anchor, rng);
-        if (data.observations[t.positive].n_points > data.observations[t.anchor].n_points)
-          std::swap(t.anchor, t.positive);
-        t.negative = sampler.negative(t.anchor, rng);
-        if (!mine || !is_cached[t.anchor]) continue;
-        float hardest = cachedDistance(t.anchor, t.negative);
-        for (int k = 1; k < config.hard_negative_candidates; ++k) {
-          const size_t c = sampler.negative(t.anchor, rng);
-          const float d = cachedDistance(t.anchor, c);
-          if (d < hardest) hardest = d, t.negative = c;
-        }
-      }
-
-      const BatchLoss b = batchLoss(*net, data, triplets, config, config.augment, rng);
-      const torch::Tensor loss = b.triplet + config.reconstruction_weight * b.reconstruction;
-      optimizer.zero_grad();
-      loss.backward();
-      optimizer.step();
-
-      const torch::Tensor d = b.descriptors.detach().to(torch::kFloat).contiguous();
-      const float* dp = d.data_ptr<float>();
-      for (size_t r = 0; r < 3 * batch; ++r) {
-        const Triplet& t = triplets[r % batch];
-        const size_t i = r < batch ? t.anchor : r < 2 * batch ? t.positive : t.negative;
-        cached.row(static_cast<Eigen::Index>(i)) =
-            Eigen::Map<const Eigen::RowVectorXf>(dp + r * static_cast<size_t>(dim), dim);
-        is_cached[i] = 1;
-      }
-      loss_mean.add(loss.item<double>());
-      triplet_mean.add(b.triplet.item<double>());
-      recon_mean.add(b.reconstruction.item<double>());
-      if (callbacks.step) callbacks.step(epoch, step + 1, steps, loss_mean.value());
-    }
-
-    EpochStats stats;
-    stats.epoch = epoch;
-    stats.loss = loss_mean.value();
-    stats.triplet_loss = triplet_mean.value();
-    stats.reconstruction_loss = recon_mean.value();
-    stats.learning_rate = learning_rate;
-    stats.validation =
-        validationAccuracy(*net, data, split.validation, config.seed, config.max_validation_queries,
-                           config.validation_min_completeness);
+    EpochStats stats = training.epoch(epoch, callbacks);
     // Without validation queries (tiny data), the training loss is all there is to go by.
     const double score = stats.validation.queries > 0 ? stats.validation.top1 : -stats.loss;
     if (score > best_score) {
       best_score = score;
-      best.take(*net);
+      best.take(training.net());
       result.best_epoch = epoch;
       stats.best = true;
-      if (!out.empty()) saveNet(out, *net);
+      if (callbacks.best) callbacks.best(training.net());
     }
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     result.history.push_back(stats);
     if (callbacks.epoch) callbacks.epoch(stats);
-
-    learning_rate *= config.learning_rate_decay;
-    for (auto& group : optimizer.param_groups())
-      static_cast<torch::optim::AdamOptions&>(group.options()).lr(learning_rate);
+    training.decayLearningRate();
   }
-  best.restore(*net);
-  result.net = net;
+  best.restore(training.net());
+  result.net = training.sharedNet();
   return result;
 }
 

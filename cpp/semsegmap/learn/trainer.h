@@ -75,14 +75,14 @@ struct TrainCallbacks {
   // After every step: epoch (from 1), steps done in it, steps in it, mean loss so far.
   std::function<void(int, size_t, size_t, double)> step;
   std::function<void(const EpochStats&)> epoch;
+  // Each time the best epoch improves, with the network in that state (e.g. to save it).
+  std::function<void(DescriptorNetImpl&)> best;
 };
 
 // Trains a new network on `data`. The best epoch is the one of highest validation top-1 (the
-// lowest training loss when the validation half has no query); when `out` is not empty it is
-// saved there with saveNet each time it improves. Throws std::invalid_argument on a bad config
-// and std::runtime_error when the data has no instance seen twice.
+// lowest training loss when the validation half has no query). Throws std::invalid_argument on a
+// bad config and std::runtime_error when the data has no instance seen twice.
 TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
-                            const std::filesystem::path& out = {},
                             const TrainCallbacks& callbacks = {});
 
 // Descriptors (one row each) of data.observations[which[i]], unaugmented, in eval mode; the

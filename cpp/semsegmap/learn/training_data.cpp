@@ -2,16 +2,14 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
 #include <map>
 #include <numeric>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
+#include "semsegmap/core/binary_io.h"
 #include "semsegmap/core/random.h"
-#include "semsegmap/io/atomic_file.h"
-#include "semsegmap/io/open_dataset.h"
 #include "semsegmap/pipeline/pipeline.h"
 
 namespace semsegmap {
@@ -67,10 +65,10 @@ TrainingObservation compact(const SegmentObservation& obs, uint16_t source, Segm
 }
 
 void appendSegment(const Segment& s, uint16_t source, const ExtractionConfig& config,
-                   TrainingSet& out) {
+                   uint16_t first_transient, TrainingSet& out) {
   for (size_t k = 0; k < s.observations.size(); ++k) {
     const SegmentObservation& obs = s.observations[k];
-    if (obs.gt_instance == 0 || obs.gt_instance >= config.first_transient_instance ||
+    if (obs.gt_instance == 0 || (first_transient > 0 && obs.gt_instance >= first_transient) ||
         obs.gt_purity <= config.min_purity || obs.points.empty())
       continue;
     out.observations.push_back(
@@ -96,249 +94,12 @@ void appendObservations(FrameSource& source, uint16_t source_index, PipelineConf
       config.max_frames > 0 ? std::min(source.size(), config.max_frames) : source.size();
   for (size_t i = 0; i < n; ++i) {
     FrameResult r = pipe.process(source.frame(i));
-    for (const Segment& s : r.segmentation.finished) appendSegment(s, source_index, config, out);
+    for (const Segment& s : r.segmentation.finished)
+      appendSegment(s, source_index, config, info.first_transient_instance, out);
     if (progress) progress(i + 1, n, source_index);
   }
-  for (const Segment& s : pipe.finish()) appendSegment(s, source_index, config, out);
-}
-
-TrainingSet extractTrainingSet(const std::vector<std::string>& specs,
-                               const PipelineConfig& pipeline, const ExtractionConfig& config,
-                               const ExtractionProgress& progress) {
-  if (specs.empty()) throw std::invalid_argument("no dataset to extract training data from");
-  if (specs.size() > 0xffff) throw std::invalid_argument("too many datasets (at most 65535)");
-  TrainingSet set;
-  set.sources = specs;
-  for (const auto& spec : specs) set.source_worlds.push_back(worldOf(spec));
-  for (size_t i = 0; i < specs.size(); ++i) {
-    auto source = openDataset(specs[i]);
-    appendObservations(*source, static_cast<uint16_t>(i), pipeline, config, set, progress);
-  }
-  return set;
-}
-
-std::string worldOf(const std::string& spec) {
-  if (spec.rfind("sim:", 0) != 0) return spec;
-  // The defaults of openDataset: world 1, the full preset.
-  std::string world = "1", preset = "full";
-  std::stringstream ss(spec.substr(4));
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    const auto eq = item.find('=');
-    if (eq == std::string::npos) continue;
-    if (item.substr(0, eq) == "world") world = item.substr(eq + 1);
-    if (item.substr(0, eq) == "preset") preset = item.substr(eq + 1);
-  }
-  return "sim:world=" + world + ",preset=" + preset;
-}
-
-std::vector<std::string> splitDatasetSpecs(const std::string& list) {
-  auto isSimKey = [](const std::string& token) {
-    const auto eq = token.find('=');
-    return eq != std::string::npos && eq > 0 && token.find_first_of("/:") == std::string::npos;
-  };
-  std::vector<std::string> specs;
-  size_t start = 0;
-  while (start <= list.size()) {
-    const size_t end = std::min(list.find(';', start), list.size());
-    const std::string group = list.substr(start, end - start);
-    bool in_sim = false;
-    size_t token_start = 0;
-    while (token_start <= group.size()) {
-      const size_t token_end = std::min(group.find(',', token_start), group.size());
-      const std::string token = group.substr(token_start, token_end - token_start);
-      if (in_sim && isSimKey(token)) {
-        specs.back() += "," + token;
-      } else {
-        if (token.empty())
-          throw std::invalid_argument("dataset list '" + list + "': empty dataset spec");
-        specs.push_back(token);
-        in_sim = token.rfind("sim:", 0) == 0;
-      }
-      token_start = token_end + 1;
-    }
-    start = end + 1;
-  }
-  return specs;
-}
-
-// ---- Cache -------------------------------------------------------------------------------------
-
-namespace {
-
-// Layout (host byte order, little-endian on every platform we build for):
-//   "SSMTRAIN" u32 version | str provenance | u32 n, n x (str source, str world) |
-//   u64 n, n x observation |
-//   u64 FNV-1a of every byte after the version
-// str = u32 length + bytes; observation = u16 instance, u16 class, u16 source, i64 segment,
-//   u32 n_points, f32 purity, 3 x f32 centroid, u32 count, count x 6 f32, count x u16 class,
-//   count x u8 colored.
-constexpr char kCacheMagic[8] = {'S', 'S', 'M', 'T', 'R', 'A', 'I', 'N'};
-constexpr uint32_t kCacheVersion = 2;
-
-struct Fnv {
-  uint64_t h = 1469598103934665603ULL;
-  void add(const void* data, size_t n) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ULL;
-  }
-};
-
-class Writer {
- public:
-  explicit Writer(std::ostream& out) : out_(out) {}
-  void bytes(const void* data, size_t n) {
-    fnv_.add(data, n);
-    out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
-  }
-  template <typename T>
-  void value(T v) {
-    bytes(&v, sizeof v);
-  }
-  void str(const std::string& s) {
-    value(static_cast<uint32_t>(s.size()));
-    bytes(s.data(), s.size());
-  }
-  template <typename T>
-  void array(const std::vector<T>& v) {
-    bytes(v.data(), v.size() * sizeof(T));
-  }
-  uint64_t hash() const { return fnv_.h; }
-
- private:
-  std::ostream& out_;
-  Fnv fnv_;
-};
-
-class Reader {
- public:
-  Reader(std::istream& in, const std::filesystem::path& path) : in_(in), path_(path) {}
-  void bytes(void* data, size_t n) {
-    if (!in_.read(static_cast<char*>(data), static_cast<std::streamsize>(n)))
-      throw std::runtime_error(path_.string() + ": truncated training cache");
-    fnv_.add(data, n);
-  }
-  template <typename T>
-  T value() {
-    T v;
-    bytes(&v, sizeof v);
-    return v;
-  }
-  // Sizes are checked against what is left of the file, so that a corrupt count fails cleanly
-  // instead of allocating gigabytes.
-  size_t count(size_t element_bytes) {
-    const uint64_t n = value<uint64_t>();
-    if (element_bytes > 0 && n > remaining() / element_bytes)
-      throw std::runtime_error(path_.string() + ": corrupt training cache (bad count)");
-    return static_cast<size_t>(n);
-  }
-  std::string str() {
-    const uint32_t n = value<uint32_t>();
-    if (n > remaining()) throw std::runtime_error(path_.string() + ": corrupt training cache");
-    std::string s(n, '\0');
-    bytes(s.data(), n);
-    return s;
-  }
-  template <typename T>
-  void array(std::vector<T>& v, size_t n) {
-    v.resize(n);
-    bytes(v.data(), n * sizeof(T));
-  }
-  uint64_t hash() const { return fnv_.h; }
-  uint64_t remaining() {
-    const auto here = in_.tellg();
-    in_.seekg(0, std::ios::end);
-    const auto end = in_.tellg();
-    in_.seekg(here);
-    return static_cast<uint64_t>(end - here);
-  }
-
- private:
-  std::istream& in_;
-  std::filesystem::path path_;
-  Fnv fnv_;
-};
-
-}  // namespace
-
-void writeTrainingCache(const std::filesystem::path& path, const TrainingSet& set,
-                        const std::string& provenance) {
-  writeFileAtomically(path, [&](std::ostream& out) {
-    out.write(kCacheMagic, sizeof kCacheMagic);
-    out.write(reinterpret_cast<const char*>(&kCacheVersion), sizeof kCacheVersion);
-    Writer w(out);
-    w.str(provenance);
-    w.value(static_cast<uint32_t>(set.sources.size()));
-    for (size_t i = 0; i < set.sources.size(); ++i) {
-      w.str(set.sources[i]);
-      w.str(i < set.source_worlds.size() ? set.source_worlds[i] : set.sources[i]);
-    }
-    w.value(static_cast<uint64_t>(set.observations.size()));
-    for (const TrainingObservation& o : set.observations) {
-      w.value(o.instance);
-      w.value(o.majority_class);
-      w.value(o.source);
-      w.value(o.segment);
-      w.value(o.n_points);
-      w.value(o.purity);
-      for (int k = 0; k < 3; ++k) w.value(o.centroid[k]);
-      w.value(static_cast<uint32_t>(o.size()));
-      w.array(o.xyzhsv);
-      w.array(o.classes);
-      w.array(o.colored);
-    }
-    const uint64_t hash = w.hash();
-    out.write(reinterpret_cast<const char*>(&hash), sizeof hash);
-  });
-}
-
-std::optional<TrainingSet> readTrainingCache(const std::filesystem::path& path,
-                                             const std::string& provenance) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  char magic[sizeof kCacheMagic];
-  uint32_t version = 0;
-  if (!in.read(magic, sizeof magic) || std::memcmp(magic, kCacheMagic, sizeof magic) != 0)
-    throw std::runtime_error(path.string() + ": not a training cache (bad magic)");
-  if (!in.read(reinterpret_cast<char*>(&version), sizeof version))
-    throw std::runtime_error(path.string() + ": truncated training cache");
-  // An older layout is not an error: the data is simply extracted again.
-  if (version != kCacheVersion) return std::nullopt;
-  Reader r(in, path);
-  if (r.str() != provenance) return std::nullopt;
-  TrainingSet set;
-  const uint32_t n_sources = r.value<uint32_t>();
-  if (n_sources > r.remaining() / 8)
-    throw std::runtime_error(path.string() + ": corrupt training cache (bad source count)");
-  for (uint32_t i = 0; i < n_sources; ++i) {
-    set.sources.push_back(r.str());
-    set.source_worlds.push_back(r.str());
-  }
-  set.observations.resize(r.count(38));  // 38: the fixed part of an observation
-  for (TrainingObservation& o : set.observations) {
-    o.instance = r.value<uint16_t>();
-    o.majority_class = r.value<ClassId>();
-    o.source = r.value<uint16_t>();
-    o.segment = r.value<int64_t>();
-    o.n_points = r.value<uint32_t>();
-    o.purity = r.value<float>();
-    for (int k = 0; k < 3; ++k) o.centroid[k] = r.value<float>();
-    const uint32_t n = r.value<uint32_t>();
-    if (n > r.remaining() / 27)
-      throw std::runtime_error(path.string() + ": corrupt training cache");
-    r.array(o.xyzhsv, 6 * size_t{n});
-    r.array(o.classes, n);
-    r.array(o.colored, n);
-    if (o.source >= set.sources.size())
-      throw std::runtime_error(path.string() + ": corrupt training cache (bad source index)");
-  }
-  const uint64_t expected = r.hash();
-  uint64_t stored = 0;
-  if (!in.read(reinterpret_cast<char*>(&stored), sizeof stored))
-    throw std::runtime_error(path.string() + ": truncated training cache");
-  if (stored != expected)
-    throw std::runtime_error(path.string() + ": corrupt training cache (checksum mismatch)");
-  return set;
+  for (const Segment& s : pipe.finish())
+    appendSegment(s, source_index, config, info.first_transient_instance, out);
 }
 
 // ---- Pairs, negatives and the validation split -------------------------------------------------
@@ -347,9 +108,7 @@ std::vector<uint64_t> objectKeys(const TrainingSet& set) {
   std::vector<uint64_t> world(set.sources.size());
   for (size_t s = 0; s < world.size(); ++s) {
     const std::string& name = s < set.source_worlds.size() ? set.source_worlds[s] : set.sources[s];
-    Fnv fnv;
-    fnv.add(name.data(), name.size());
-    world[s] = fnv.h;
+    world[s] = fnv1a64(name.data(), name.size());
   }
   std::vector<uint64_t> keys;
   keys.reserve(set.observations.size());

@@ -5,9 +5,7 @@
 #pragma once
 
 #include <cstdint>
-#include <filesystem>
 #include <functional>
-#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -46,16 +44,11 @@ struct TrainingSet {
   std::vector<TrainingObservation> observations;
 };
 
-// "sim:world=N,preset=P" for a sim spec, whatever its run, condition, traffic or frames; the spec
-// itself for anything else (a dataset directory is a world of its own).
-std::string worldOf(const std::string& spec);
-
 struct ExtractionConfig {
   float min_purity = 0.8f;  // observations at or below this purity are ambiguous labels
-  // Instances from here on are traffic (sim::kTrafficInstanceBase): a parked car whose points
-  // the cameras mislabelled as building survives the dynamic-class filter, but it is no
-  // landmark, and another traffic seed puts other cars there.
-  uint16_t first_transient_instance = 60000;
+  // Instances from DatasetInfo::first_transient_instance on are traffic and never kept: a parked
+  // car whose points the cameras mislabelled as building survives the dynamic-class filter, but
+  // it is no landmark, and another traffic seed puts other cars there.
   size_t max_frames = 0;  // per dataset; 0: all frames
   // Larger observations keep a random subset: memory stays bounded, and the networks see at
   // most a few thousand points anyway (semsegmap-net subsamples to NetConfig::num_points).
@@ -71,27 +64,6 @@ using ExtractionProgress = std::function<void(size_t, size_t, size_t)>;
 void appendObservations(FrameSource& source, uint16_t source_index, PipelineConfig pipeline,
                         const ExtractionConfig& config, TrainingSet& out,
                         const ExtractionProgress& progress = {});
-
-// openDataset() on each spec, then appendObservations. Throws when a dataset has no ground-truth
-// poses or no point instances (nothing to learn from).
-TrainingSet extractTrainingSet(const std::vector<std::string>& specs,
-                               const PipelineConfig& pipeline, const ExtractionConfig& config,
-                               const ExtractionProgress& progress = {});
-
-// A comma-separated list of dataset specs, where a sim spec has commas of its own: a token of
-// the form key=value (no '/' or ':') continues the sim: spec before it, any other token starts a
-// new spec; ';' always separates. "sim:world=1,run=S1,sim:world=1,run=S1,condition=sunrise"
-// is two specs. Throws std::invalid_argument on an empty list or an empty spec.
-std::vector<std::string> splitDatasetSpecs(const std::string& list);
-
-// The cache of extracted observations, so that a second training run does not re-run the
-// simulator. `provenance` says what the data was made from (specs, configuration); read returns
-// nullopt when the file is missing or was made from something else, and throws naming the file
-// when it is truncated or corrupt. Written to a temporary name and renamed.
-void writeTrainingCache(const std::filesystem::path& path, const TrainingSet& set,
-                        const std::string& provenance);
-std::optional<TrainingSet> readTrainingCache(const std::filesystem::path& path,
-                                             const std::string& provenance);
 
 // ---- Pairs, negatives and the validation split -------------------------------------------------
 

@@ -78,6 +78,17 @@ void DescriptorIndex::build(const Eigen::Ref<const DescriptorMatrix>& descriptor
   impl_ = std::move(impl);
 }
 
+void DescriptorIndex::add(const Eigen::Ref<const DescriptorMatrix>& descriptors) {
+  if (!impl_->index) throw std::logic_error("DescriptorIndex::add before build");
+  if (descriptors.cols() != impl_->index->d)
+    throw std::invalid_argument("DescriptorIndex::add: dimension " +
+                                std::to_string(descriptors.cols()) + " but the index has " +
+                                std::to_string(impl_->index->d));
+  if (descriptors.rows() == 0) return;
+  DescriptorMatrix storage;
+  impl_->index->add(static_cast<FaissId>(descriptors.rows()), packedRows(descriptors, storage));
+}
+
 void DescriptorIndex::setProbes(int probes) {
   if (probes <= 0) throw std::invalid_argument("DescriptorIndex: probes must be positive");
   config_.ivf_probes = probes;

@@ -66,6 +66,9 @@ class DescriptorIndex {
   // (e.g. a column-major MatrixXf) is converted by Eigen into a row-major temporary.
   void build(const Eigen::Ref<const DescriptorMatrix>& descriptors);
 
+  // Appends rows with the next ids (the index must have been built, with the same dimension).
+  void add(const Eigen::Ref<const DescriptorMatrix>& descriptors);
+
   bool approximate() const;
   size_t size() const;
   int dimension() const;  // 0 before build()

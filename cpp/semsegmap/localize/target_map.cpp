@@ -64,4 +64,21 @@ std::vector<Eigen::Vector3f> subsamplePoints(const std::vector<Eigen::Vector3f>&
   return out;
 }
 
+void checkMapCompatible(const std::string& map_name, const TargetMap& map,
+                        const std::string& descriptor, const std::string& fingerprint,
+                        int dimension) {
+  const std::string where = map_name + ": ";
+  if (map.descriptor != descriptor)
+    throw std::runtime_error(where + "map built with " + map.descriptor +
+                             " descriptors, the configuration uses " + descriptor);
+  if (map.dimension() != dimension)
+    throw std::runtime_error(where + "map descriptors have dimension " +
+                             std::to_string(map.dimension()) + ", the describer gives " +
+                             std::to_string(dimension));
+  if (map.fingerprint != fingerprint)
+    throw std::runtime_error(where + "map built with model " + map.fingerprint +
+                             ", the configuration's model is " + fingerprint +
+                             " (rebuild the map with this model)");
+}
+
 }  // namespace semsegmap

@@ -62,4 +62,10 @@ class TargetMapBuilder {
 std::vector<Eigen::Vector3f> subsamplePoints(const std::vector<Eigen::Vector3f>& points,
                                              size_t max_points);
 
+// Throws std::runtime_error "<map_name>: ..." (the map's file, say) when the map's descriptors
+// cannot be compared with those of the running describer (another kind, dimension or model).
+void checkMapCompatible(const std::string& map_name, const TargetMap& map,
+                        const std::string& descriptor, const std::string& fingerprint,
+                        int dimension);
+
 }  // namespace semsegmap

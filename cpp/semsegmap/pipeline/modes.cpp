@@ -1,6 +1,7 @@
 #include "semsegmap/pipeline/modes.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace semsegmap {
@@ -10,8 +11,7 @@ namespace {
 // Feeds the run's frames (at most options.max_frames) to a mapping or localization session.
 template <typename Session>
 void feed(FrameSource& source, const RunOptions& options, Session& session) {
-  const size_t n =
-      options.max_frames > 0 ? std::min(source.size(), options.max_frames) : source.size();
+  const size_t n = options.frameCount(source);
   for (size_t i = 0; i < n; ++i) {
     session.process(source.frame(i));
     if (options.progress) options.progress(i + 1, n);
@@ -33,18 +33,11 @@ MapSegment mapSegmentOf(const Segment& s, size_t points) {
 
 }  // namespace
 
-std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int threads) {
-  DescriberOptions options;
-  options.model_path = config.model;
-  options.threads = threads;
-  return makeDescriber(parseDescriptorKind(config.kind), options);
-}
-
 MappingSession::MappingSession(const PipelineConfig& config, const DatasetInfo& info,
-                               PoseSource poses, Describer& describer)
+                               PoseSource poses, std::shared_ptr<Describer> describer)
     : config_(config),
-      pipeline_(config, info, poses, &describer),
-      builder_(descriptorName(describer.kind()), describer.fingerprint(), describer.dimension(),
+      pipeline_(config, info, poses, describer),
+      builder_(descriptorName(describer->kind()), describer->fingerprint(), describer->dimension(),
                config.target_map) {}
 
 void MappingSession::add(const std::vector<Segment>& segments,
@@ -56,7 +49,7 @@ void MappingSession::add(const std::vector<Segment>& segments,
 
 void MappingSession::process(const Frame& frame) {
   const FrameResult r = pipeline_.process(frame);
-  run_.trajectory.push_back(r.T_map_base);
+  run_.trajectory.push_back(r.T_local_base);
   add(r.segmentation.finished, r.finished_descriptors);
   run_.stats.total += r.times;
   ++run_.stats.frames;
@@ -72,67 +65,72 @@ MappingRun MappingSession::finish() {
 }
 
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
-                      Describer& describer, const RunOptions& options) {
+                      std::shared_ptr<Describer> describer, const RunOptions& options) {
   MappingSession session(config, source.info(), poses, describer);
   feed(source, options, session);
   return session.finish();
 }
 
 namespace {
-const TargetMap& checkedMap(const TargetMap& map, const Describer& describer) {
-  if (map.descriptor != descriptorName(describer.kind()) ||
-      map.fingerprint != describer.fingerprint() || map.dimension() != describer.dimension())
-    throw std::invalid_argument("the target map's descriptors (" + map.descriptor + " " +
-                                map.fingerprint + ") do not match the describer's (" +
-                                descriptorName(describer.kind()) + " " + describer.fingerprint() +
-                                ")");
+std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map,
+                                            const Describer& describer) {
+  if (!map) throw std::invalid_argument("no target map");
+  checkMapCompatible("the target map", *map, descriptorName(describer.kind()),
+                     describer.fingerprint(), describer.dimension());
   return map;
 }
 }  // namespace
 
 LocalizationSession::LocalizationSession(const PipelineConfig& config, const DatasetInfo& info,
-                                         const TargetMap& map, Describer& describer)
-    : map_(checkedMap(map, describer)),
-      localizer_(map, config.localization.localizer),
-      pipeline_(config, info, PoseSource::kOdometry, &describer) {
-  pipeline_.setLocalizer(&localizer_);
-}
+                                         std::shared_ptr<const TargetMap> map,
+                                         std::shared_ptr<Describer> describer)
+    : config_(config),
+      localizer_(checkedMap(std::move(map), *describer), config.localization.localizer),
+      pipeline_(config, info, PoseSource::kOdometry, std::move(describer)) {}
 
 void LocalizationSession::process(const Frame& frame) {
-  const FrameResult r = pipeline_.process(frame);
+  FrameResult r = pipeline_.process(frame);
   if (!run_.trajectory_odom.empty())
     run_.distance_m +=
-        (r.T_map_base.translation() - run_.trajectory_odom.back().translation()).norm();
-  run_.trajectory_odom.push_back(r.T_map_base);
-  if (frame.T_world_base_gt) run_.trajectory_gt.push_back(*frame.T_world_base_gt);
+        (r.T_local_base.translation() - run_.trajectory_odom.back().translation()).norm();
+  run_.trajectory_odom.push_back(r.T_local_base);
+  if (frame.T_world_base) run_.trajectory_gt.push_back(*frame.T_world_base);
+  const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
+  if (frames_++ % every == 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const LocalSegmentQuery q = pipeline_.localSegmentQuery();
+    const auto found = localizer_.localize(q.centroids, q.descriptors);
+    r.times.localize_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (found) record(frame, r, *found, q);
+  }
   run_.stats.total += r.times;
   ++run_.stats.frames;
-  if (!r.localization) return;
-  const Localization& l = *r.localization;
+}
+
+void LocalizationSession::record(const Frame& frame, const FrameResult& r, const Localization& l,
+                                 const LocalSegmentQuery& q) {
   LocalizationRecord rec;
   rec.frame_index = frame.index;
   rec.timestamp_s = frame.timestamp_s;
-  rec.T_map_robot = l.T_map_local * r.T_map_base;
+  rec.T_map_base = l.T_map_local * r.T_local_base;
   rec.inliers = l.inliers;
   rec.candidates = l.candidates;
-  if (frame.T_world_base_gt) {
-    rec.T_map_robot_gt = *frame.T_world_base_gt;
-    rec.translation_error_m = translationError(rec.T_map_robot, *frame.T_world_base_gt);
-    rec.rotation_error_deg = rotationErrorDeg(rec.T_map_robot, *frame.T_world_base_gt);
+  if (frame.T_world_base) {
+    rec.T_world_base = *frame.T_world_base;
+    rec.translation_error_m = translationError(rec.T_map_base, *frame.T_world_base);
+    rec.rotation_error_deg = rotationErrorDeg(rec.T_map_base, *frame.T_world_base);
   }
-  const auto& local = pipeline_.localSegments();
-  for (const auto& [q, t] : l.matches) {
-    const Eigen::Vector3f c = local.at(r.query_segments.at(q)).centroid;
-    rec.matches.emplace_back((l.T_map_local * c.cast<double>()).cast<float>(),
-                             map_.segments.at(t).centroid);
-  }
+  for (const auto& [query, target] : l.matches)
+    rec.matches.emplace_back((l.T_map_local * q.centroids.at(query).cast<double>()).cast<float>(),
+                             localizer_.map().segments.at(target).centroid);
   run_.localizations.push_back(std::move(rec));
 }
 
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
-                                const TargetMap& map, Describer& describer,
-                                const RunOptions& options) {
-  LocalizationSession session(config, source.info(), map, describer);
+                                std::shared_ptr<const TargetMap> map,
+                                std::shared_ptr<Describer> describer, const RunOptions& options) {
+  LocalizationSession session(config, source.info(), std::move(map), std::move(describer));
   feed(source, options, session);
   return session.take();
 }
@@ -142,7 +140,7 @@ LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {
   s.localizations = records.size();
   size_t with_gt = 0;
   for (const LocalizationRecord& r : records) {
-    if (!r.T_map_robot_gt) continue;
+    if (!r.T_world_base) continue;
     ++with_gt;
     s.below_1m += r.translation_error_m < 1.0;
     s.below_5m += r.translation_error_m < 5.0;

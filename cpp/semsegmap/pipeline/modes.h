@@ -3,6 +3,7 @@
 // close loops while mapping. The apps only parse arguments and write files around these.
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -12,12 +13,13 @@
 
 namespace semsegmap {
 
-// The describer a configuration asks for (descriptor.kind, descriptor.model).
-std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int threads = 0);
-
 struct RunOptions {
   size_t max_frames = 0;                                    // 0: all
   std::function<void(size_t done, size_t total)> progress;  // optional
+  // The frames a run reads of `source`: the first max_frames, or all.
+  size_t frameCount(const FrameSource& source) const {
+    return max_frames > 0 ? std::min(source.size(), max_frames) : source.size();
+  }
 };
 
 struct RunStats {
@@ -40,7 +42,7 @@ struct MappingRun {
 class MappingSession {
  public:
   MappingSession(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
-                 Describer& describer);
+                 std::shared_ptr<Describer> describer);
   void process(const Frame& frame);
   MappingRun finish();  // once, after the last frame
 
@@ -53,15 +55,17 @@ class MappingSession {
 };
 
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
-                      Describer& describer, const RunOptions& options = {});
+                      std::shared_ptr<Describer> describer, const RunOptions& options = {});
 
 struct LocalizationRecord {
   size_t frame_index = 0;
   double timestamp_s = 0.0;
-  Pose T_map_robot = Pose::Identity();
+  Pose T_map_base = Pose::Identity();  // T_map_local * T_local_base
   int inliers = 0;
   size_t candidates = 0;
-  std::optional<Pose> T_map_robot_gt;  // when the dataset has ground truth (map frame = world)
+  // Ground truth, when the dataset has it; errors compare it with T_map_base, so they assume a
+  // target map built in the world frame (with ground-truth poses).
+  std::optional<Pose> T_world_base;
   double translation_error_m = 0.0, rotation_error_deg = 0.0;  // only with ground truth
   // Matched centroids: the local one carried into the map by the estimate, and the target's.
   std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> matches;
@@ -75,28 +79,30 @@ struct LocalizationRun {
   RunStats stats;
 };
 
-// Localizes every frame's local segment map (built on odometry, as a robot would) against
-// `map`; checks the describer against the map first (kind, dimension and model). `map` must
-// outlive the session.
+// Localizes the local segment map (built on odometry, as a robot would) against `map` every
+// config.localization.every_n_frames frames; checks the describer against the map first (kind,
+// dimension and model).
 class LocalizationSession {
  public:
-  LocalizationSession(const PipelineConfig& config, const DatasetInfo& info, const TargetMap& map,
-                      Describer& describer);
-  LocalizationSession(const LocalizationSession&) = delete;  // the pipeline points at localizer_
-  LocalizationSession& operator=(const LocalizationSession&) = delete;
+  LocalizationSession(const PipelineConfig& config, const DatasetInfo& info,
+                      std::shared_ptr<const TargetMap> map, std::shared_ptr<Describer> describer);
   void process(const Frame& frame);
   const LocalizationRun& run() const { return run_; }
   LocalizationRun take() { return std::move(run_); }
 
  private:
-  const TargetMap& map_;
+  void record(const Frame& frame, const FrameResult& r, const Localization& l,
+              const LocalSegmentQuery& q);
+  PipelineConfig config_;
   Localizer localizer_;
   Pipeline pipeline_;
   LocalizationRun run_;
+  size_t frames_ = 0;
 };
 
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
-                                const TargetMap& map, Describer& describer,
+                                std::shared_ptr<const TargetMap> map,
+                                std::shared_ptr<Describer> describer,
                                 const RunOptions& options = {});
 
 struct LocalizationSummary {

@@ -28,20 +28,13 @@ PoseSource parsePoseSource(const std::string& name) {
 }
 
 Pipeline::Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
-                   Describer* describer)
+                   std::shared_ptr<Describer> describer)
     : config_(config),
       info_(info),
       poses_(poses),
       local_map_(config.local_map, info.classes),
       segmenter_(config.segmentation),
-      describer_(describer) {}
-
-void Pipeline::setLocalizer(const Localizer* localizer, const std::vector<bool>* usable) {
-  if (localizer && !describer_)
-    throw std::invalid_argument("a localizing pipeline needs a describer");
-  localizer_ = localizer;
-  usable_ = usable;
-}
+      describer_(std::move(describer)) {}
 
 void Pipeline::describe(const std::vector<SegmentId>& ids, size_t frame_index) {
   const size_t batch = static_cast<size_t>(std::max(1, config_.descriptor.batch));
@@ -98,12 +91,12 @@ FrameResult Pipeline::process(const Frame& frame) {
   FrameResult r;
   r.frame_index = frame.index;
   if (poses_ == PoseSource::kGroundTruth) {
-    if (!frame.T_world_base_gt)
+    if (!frame.T_world_base)
       throw std::runtime_error("frame " + std::to_string(frame.index) +
                                " has no ground-truth pose (use --poses odom)");
-    r.T_map_base = *frame.T_world_base_gt;
+    r.T_local_base = *frame.T_world_base;
   } else {
-    r.T_map_base = frame.T_world_base_odom;
+    r.T_local_base = frame.T_odom_base;
   }
 
   auto t0 = std::chrono::steady_clock::now();
@@ -118,14 +111,13 @@ FrameResult Pipeline::process(const Frame& frame) {
   for (const auto& cam : frame.cameras) semantic = semantic || !cam.label.empty();
   for (size_t k = 0; !semantic && k < frame.point_labels.size(); ++k)
     semantic = frame.point_labels[k].class_id != cls::kUnknown;
-  r.map_update = local_map_.update(cloud, r.T_map_base * info_.rig.T_base_lidar,
-                                   r.T_map_base.translation().head<2>(), semantic);
+  r.map_update = local_map_.update(cloud, r.T_local_base * info_.rig.T_base_lidar,
+                                   r.T_local_base.translation().head<2>(), semantic);
   r.times.local_map_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
   r.segmentation = segmenter_.update(local_map_, r.map_update, frame.index, frame.timestamp_s);
   r.times.segment_ms = msSince(t0);
-  ++frames_;
   if (!describer_) return r;
 
   // Only segments whose observation changed are described again: most of the local map is the
@@ -139,14 +131,6 @@ FrameResult Pipeline::process(const Frame& frame) {
     described_.erase(s.id);
   }
   r.times.describe_ms = msSince(t0);
-
-  if (localizer_ && (frames_ - 1) % std::max<size_t>(1, config_.localization.every_n_frames) == 0) {
-    t0 = std::chrono::steady_clock::now();
-    const LocalSegmentQuery q = localSegmentQuery();
-    r.localization = localizer_->localize(q.centroids, q.descriptors, usable_);
-    r.query_segments = q.ids;
-    r.times.localize_ms = msSince(t0);
-  }
   return r;
 }
 

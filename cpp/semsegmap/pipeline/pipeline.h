@@ -1,7 +1,8 @@
-// The one place that wires the stages together, frame by frame: enrich -> local map ->
-// incremental segmentation -> describe the segments whose observation changed (batched) -> local
-// segment map -> localization query. Mapping, localization and loop closure are configurations
-// of this pipeline (pipeline/modes.h), not copies of it.
+// The front end, the one place that wires the stages together frame by frame: enrich -> local
+// map -> incremental segmentation -> describe the segments whose observation changed (batched)
+// -> the local segment map, which LocalSegmentQuery hands to a localizer. Mapping, localization
+// and loop closure (pipeline/modes.h, pipeline/slam.h) run this front end and call the localizer
+// themselves.
 #pragma once
 
 #include <memory>
@@ -38,17 +39,16 @@ struct DescribedSegment {
 
 struct FrameResult {
   size_t frame_index = 0;
-  Pose T_map_base = Pose::Identity();  // the pose the local map is built with (gt or odometry)
+  Pose T_local_base = Pose::Identity();  // the pose the local map is built with: its frame is
+                                         // the world (ground-truth poses) or odometry
   size_t points = 0, colored_points = 0;
   LocalMapUpdate map_update;
   SegmentationUpdate segmentation;
   // Parallel to segmentation.finished when a describer is set: the final observation's
   // descriptor.
   std::vector<Eigen::VectorXf> finished_descriptors;
-  size_t described = 0;                      // segments described this frame
-  std::optional<Localization> localization;  // when a localizer is set and it succeeded
-  std::vector<SegmentId> query_segments;     // local segment of each Localization match index
-  StageTimes times;
+  size_t described = 0;  // segments described this frame
+  StageTimes times;      // localize_ms is filled by the mode that localizes
 };
 
 // The local segment map as a localization query: ids in ascending order (a deterministic query
@@ -61,13 +61,10 @@ struct LocalSegmentQuery {
 
 class Pipeline {
  public:
-  // `describer` (optional, not owned) turns segment observations into descriptors.
+  // `describer` (optional; shared, e.g. by several runs of one experiment, but used by one
+  // pipeline at a time) turns segment observations into descriptors.
   Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
-           Describer* describer = nullptr);
-
-  // Optional, not owned; needs a describer. `usable` (one flag per target segment, optional)
-  // limits the matches. Queries run every config.localization.every_n_frames frames.
-  void setLocalizer(const Localizer* localizer, const std::vector<bool>* usable = nullptr);
+           std::shared_ptr<Describer> describer = nullptr);
 
   // Throws when the frame lacks the pose asked for (ground truth on a dataset without it).
   FrameResult process(const Frame& frame);
@@ -75,12 +72,12 @@ class Pipeline {
   // receives their final descriptors when a describer is set.
   std::vector<Segment> finish(std::vector<Eigen::VectorXf>* descriptors = nullptr);
 
-  const LocalMap& localMap() const { return local_map_; }
   const IncrementalSegmenter& segmenter() const { return segmenter_; }
   const std::unordered_map<SegmentId, DescribedSegment>& localSegments() const {
     return described_;
   }
   LocalSegmentQuery localSegmentQuery() const;
+  const Describer* describer() const { return describer_.get(); }
 
  private:
   void describe(const std::vector<SegmentId>& ids, size_t frame_index);
@@ -92,11 +89,8 @@ class Pipeline {
   PoseSource poses_;
   LocalMap local_map_;
   IncrementalSegmenter segmenter_;
-  Describer* describer_ = nullptr;
-  const Localizer* localizer_ = nullptr;
-  const std::vector<bool>* usable_ = nullptr;
+  std::shared_ptr<Describer> describer_;
   std::unordered_map<SegmentId, DescribedSegment> described_;
-  size_t frames_ = 0;
 };
 
 }  // namespace semsegmap

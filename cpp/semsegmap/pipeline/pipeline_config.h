@@ -5,6 +5,7 @@
 #include <string>
 
 #include "semsegmap/enrich/enricher.h"
+#include "semsegmap/graph/pose_graph.h"
 #include "semsegmap/local_map/local_map.h"
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/target_map.h"
@@ -28,8 +29,8 @@ struct LoopClosureConfig {
   // matching the robot against what it has just seen would only confirm odometry.
   double exclude_recent_m = 60.0;
   double min_travel_between_loops_m = 5.0;  // one loop edge per place, not one per frame
-  double odometry_translation_sigma_m = 0.05, odometry_rotation_sigma_rad = 0.005;
-  double loop_translation_sigma_m = 0.3, loop_rotation_sigma_rad = 0.02;
+  // Odometry sigma 0.05 m / 0.005 rad, loop sigma 0.3 m / 0.02 rad.
+  PoseGraphConfig graph{0.05, 0.005, 0.3, 0.02};
 };
 
 struct PipelineConfig {

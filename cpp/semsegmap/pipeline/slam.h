@@ -30,7 +30,7 @@ struct SlamRun {
   double graph_ms = 0.0;  // pose graph optimization, summed
 };
 
-SlamRun runSlam(FrameSource& source, const PipelineConfig& config, Describer& describer,
-                const RunOptions& options = {});
+SlamRun runSlam(FrameSource& source, const PipelineConfig& config,
+                std::shared_ptr<Describer> describer, const RunOptions& options = {});
 
 }  // namespace semsegmap

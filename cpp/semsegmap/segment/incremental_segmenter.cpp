@@ -41,9 +41,31 @@ void IncrementalSegmenter::eraseFromCell(VoxelKey key, const Eigen::Vector3f& po
 SegmentationUpdate IncrementalSegmenter::update(const LocalMap& map, const LocalMapUpdate& mu,
                                                 size_t frame_index, double timestamp_s) {
   SegmentationUpdate out;
+  removeVoxels(mu.removed, out);
+  // Grow a region from each newly active voxel that is not yet part of one.
+  std::vector<SegmentId> changed, touched;
+  std::vector<VoxelKey> region;
+  for (VoxelKey seed : addVoxels(map, mu.newly_active)) {
+    if (voxels_.at(seed).segment != kUnassigned) continue;
+    growRegion(seed, region, touched);
+    const SegmentId target = regionSegment(touched, frame_index, out, changed);
+    SegmentState& st = segments_.at(target);
+    for (VoxelKey k : region) {
+      voxels_.at(k).segment = target;
+      st.voxels.push_back(k);
+    }
+    st.live += region.size();
+    if (std::find(changed.begin(), changed.end(), target) == changed.end())
+      changed.push_back(target);
+  }
+  observeChanged(changed, map, frame_index, timestamp_s, out);
+  return out;
+}
 
-  // Voxels that left the local map leave their segments; a segment with none left is finished.
-  for (VoxelKey key : mu.removed) {
+// Voxels that left the local map leave their segments; a segment with none left is finished.
+void IncrementalSegmenter::removeVoxels(const std::vector<VoxelKey>& removed,
+                                        SegmentationUpdate& out) {
+  for (VoxelKey key : removed) {
     auto it = voxels_.find(key);
     if (it == voxels_.end()) continue;
     const SegmentId id = it->second.segment;
@@ -57,11 +79,14 @@ SegmentationUpdate IncrementalSegmenter::update(const LocalMap& map, const Local
       if (!done.observations.empty()) out.finished.push_back(std::move(done));
     }
   }
+}
 
-  // Register the newly active voxels, with the attributes the distance needs.
+// Registers the newly active voxels, with the attributes the distance needs; returns them.
+std::vector<VoxelKey> IncrementalSegmenter::addVoxels(const LocalMap& map,
+                                                      const std::vector<VoxelKey>& active) {
   std::vector<VoxelKey> seeds;
-  seeds.reserve(mu.newly_active.size());
-  for (VoxelKey key : mu.newly_active) {
+  seeds.reserve(active.size());
+  for (VoxelKey key : active) {
     const Voxel* v = map.find(key);
     if (!v || !v->active || voxels_.count(key)) continue;
     VoxelEntry e;
@@ -73,72 +98,69 @@ SegmentationUpdate IncrementalSegmenter::update(const LocalMap& map, const Local
     cells_[cellOf(e.attributes.position)].push_back({key, e.attributes, entry});
     seeds.push_back(key);
   }
+  return seeds;
+}
 
-  // Grow a region from each seed that is not yet part of one.
-  std::vector<SegmentId> changed;
-  std::vector<VoxelKey> region, queue;
-  std::vector<SegmentId> touched;
-  for (VoxelKey seed : seeds) {
-    VoxelEntry& s = voxels_.at(seed);
-    if (s.segment != kUnassigned) continue;
-    region.clear();
-    queue.assign(1, seed);
-    touched.clear();
-    s.segment = kGrowing;
-    while (!queue.empty()) {
-      const VoxelKey u = queue.back();
-      queue.pop_back();
-      region.push_back(u);
-      const DistanceVoxel a = voxels_.at(u).attributes;
-      const float inv = static_cast<float>(1.0 / config_.d_segment_m);
-      const Eigen::Vector3i c(static_cast<int>(std::floor(a.position.x() * inv)),
-                              static_cast<int>(std::floor(a.position.y() * inv)),
-                              static_cast<int>(std::floor(a.position.z() * inv)));
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            auto cell = cells_.find(packVoxelKey(c + Eigen::Vector3i(dx, dy, dz)));
-            if (cell == cells_.end()) continue;
-            for (const CellEntry& n : cell->second) {
-              VoxelEntry& e = *n.entry;
-              // Already in this region (or queued): nothing to learn from the distance.
-              if (e.segment == kGrowing || !distance_.connected(a, n.attributes)) continue;
-              if (e.segment >= 0) {
-                if (std::find(touched.begin(), touched.end(), e.segment) == touched.end())
-                  touched.push_back(e.segment);
-              } else if (e.segment == kUnassigned) {
-                e.segment = kGrowing;
-                queue.push_back(n.key);
-              }
+void IncrementalSegmenter::growRegion(VoxelKey seed, std::vector<VoxelKey>& region,
+                                      std::vector<SegmentId>& touched) {
+  region.clear();
+  touched.clear();
+  std::vector<VoxelKey> queue(1, seed);
+  voxels_.at(seed).segment = kGrowing;
+  const float inv = static_cast<float>(1.0 / config_.d_segment_m);
+  while (!queue.empty()) {
+    const VoxelKey u = queue.back();
+    queue.pop_back();
+    region.push_back(u);
+    const DistanceVoxel a = voxels_.at(u).attributes;
+    const Eigen::Vector3i c(static_cast<int>(std::floor(a.position.x() * inv)),
+                            static_cast<int>(std::floor(a.position.y() * inv)),
+                            static_cast<int>(std::floor(a.position.z() * inv)));
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          auto cell = cells_.find(packVoxelKey(c + Eigen::Vector3i(dx, dy, dz)));
+          if (cell == cells_.end()) continue;
+          for (const CellEntry& n : cell->second) {
+            VoxelEntry& e = *n.entry;
+            // Already in this region (or queued): nothing to learn from the distance.
+            if (e.segment == kGrowing || !distance_.connected(a, n.attributes)) continue;
+            if (e.segment >= 0) {
+              if (std::find(touched.begin(), touched.end(), e.segment) == touched.end())
+                touched.push_back(e.segment);
+            } else if (e.segment == kUnassigned) {
+              e.segment = kGrowing;
+              queue.push_back(n.key);
             }
           }
-    }
-    SegmentId target;
-    if (touched.empty()) {
-      target = next_id_++;
-      SegmentState& st = segments_[target];
-      st.segment.id = target;
-      st.segment.first_frame = frame_index;
-    } else {
-      // The oldest segment survives the merge, as in SegMap.
-      target = *std::min_element(touched.begin(), touched.end());
-      for (SegmentId other : touched)
-        if (other != target) {
-          absorb(target, other);
-          out.merges.push_back({other, target});
-          changed.erase(std::remove(changed.begin(), changed.end(), other), changed.end());
         }
-    }
-    SegmentState& st = segments_.at(target);
-    for (VoxelKey k : region) {
-      voxels_.at(k).segment = target;
-      st.voxels.push_back(k);
-    }
-    st.live += region.size();
-    if (std::find(changed.begin(), changed.end(), target) == changed.end())
-      changed.push_back(target);
   }
+}
 
+SegmentId IncrementalSegmenter::regionSegment(const std::vector<SegmentId>& touched,
+                                              size_t frame_index, SegmentationUpdate& out,
+                                              std::vector<SegmentId>& changed) {
+  if (touched.empty()) {
+    const SegmentId id = next_id_++;
+    SegmentState& st = segments_[id];
+    st.segment.id = id;
+    st.segment.first_frame = frame_index;
+    return id;
+  }
+  // The oldest segment survives the merge, as in SegMap.
+  const SegmentId target = *std::min_element(touched.begin(), touched.end());
+  for (SegmentId other : touched)
+    if (other != target) {
+      absorb(target, other);
+      out.merges.push_back({other, target});
+      changed.erase(std::remove(changed.begin(), changed.end(), other), changed.end());
+    }
+  return target;
+}
+
+void IncrementalSegmenter::observeChanged(const std::vector<SegmentId>& changed,
+                                          const LocalMap& map, size_t frame_index,
+                                          double timestamp_s, SegmentationUpdate& out) {
   for (SegmentId id : changed) {
     SegmentState& st = segments_.at(id);
     st.segment.last_frame = frame_index;
@@ -156,7 +178,6 @@ SegmentationUpdate IncrementalSegmenter::update(const LocalMap& map, const Local
       out.observed.push_back(id);
     }
   }
-  return out;
 }
 
 SegmentId IncrementalSegmenter::absorb(SegmentId survivor, SegmentId absorbed) {

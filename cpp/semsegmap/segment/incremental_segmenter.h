@@ -65,6 +65,16 @@ class IncrementalSegmenter {
   uint64_t cellOf(const Eigen::Vector3f& p) const;
   void eraseFromCell(VoxelKey key, const Eigen::Vector3f& position);
   SegmentId absorb(SegmentId survivor, SegmentId absorbed);
+  // The steps of update().
+  void removeVoxels(const std::vector<VoxelKey>& removed, SegmentationUpdate& out);
+  std::vector<VoxelKey> addVoxels(const LocalMap& map, const std::vector<VoxelKey>& active);
+  // The connected unassigned voxels around `seed` into `region`, and the segments they touch.
+  void growRegion(VoxelKey seed, std::vector<VoxelKey>& region, std::vector<SegmentId>& touched);
+  // A new segment, or the oldest touched one after absorbing the others.
+  SegmentId regionSegment(const std::vector<SegmentId>& touched, size_t frame_index,
+                          SegmentationUpdate& out, std::vector<SegmentId>& changed);
+  void observeChanged(const std::vector<SegmentId>& changed, const LocalMap& map,
+                      size_t frame_index, double timestamp_s, SegmentationUpdate& out);
   void observe(SegmentState& s, const LocalMap& map, size_t frame_index, double timestamp_s);
   Segment finish(SegmentState& s);
 

@@ -25,12 +25,13 @@ Simulator::Simulator(const SimConfig& config)
   info_.classes = ClassTable::Default();
   info_.has_ground_truth_poses = true;
   info_.has_point_labels = true;
+  info_.first_transient_instance = kTrafficInstanceBase;
 }
 
 Simulator::~Simulator() = default;
 
 size_t Simulator::size() const {
-  const size_t n = trajectory_.T_world_base_gt.size();
+  const size_t n = trajectory_.T_world_base.size();
   return config_.max_frames > 0 ? std::min(n, config_.max_frames) : n;
 }
 
@@ -41,9 +42,9 @@ Frame Simulator::frame(size_t index) {
   Frame f;
   f.index = index;
   f.timestamp_s = trajectory_.timestamps_s[index];
-  f.T_world_base_gt = trajectory_.T_world_base_gt[index];
-  f.T_world_base_odom = trajectory_.T_world_base_odom[index];
-  const Pose& T_world_base = *f.T_world_base_gt;
+  f.T_world_base = trajectory_.T_world_base[index];
+  f.T_odom_base = trajectory_.T_odom_base[index];
+  const Pose& T_world_base = *f.T_world_base;
   scene_->setTime(f.timestamp_s, T_world_base.translation().head<2>(), config_.agent_clearance_m);
 
   const uint64_t seed =

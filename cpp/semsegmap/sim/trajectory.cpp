@@ -127,9 +127,9 @@ Trajectory makeTrajectory(const RoadNetwork& roads, Run run, const TrajectoryCon
     const Eigen::Vector2d d =
         positionAt(std::min(s + 0.5, length)) - positionAt(std::max(s - 0.5, 0.0));
     traj.timestamps_s.push_back(k / config.rate_hz);
-    traj.T_world_base_gt.push_back(planarPose(p.x(), p.y(), 0.0, std::atan2(d.y(), d.x())));
+    traj.T_world_base.push_back(planarPose(p.x(), p.y(), 0.0, std::atan2(d.y(), d.x())));
   }
-  traj.T_world_base_odom = driftingOdometry(traj.T_world_base_gt, odometry, seed);
+  traj.T_odom_base = driftingOdometry(traj.T_world_base, odometry, seed);
   return traj;
 }
 

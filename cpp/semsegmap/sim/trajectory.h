@@ -39,8 +39,8 @@ struct OdometryNoise {
 
 struct Trajectory {
   std::vector<double> timestamps_s;
-  std::vector<Pose> T_world_base_gt;
-  std::vector<Pose> T_world_base_odom;
+  std::vector<Pose> T_world_base;
+  std::vector<Pose> T_odom_base;
   double length_m = 0.0;
 };
 

@@ -147,7 +147,6 @@ void addTree(WorldContext& ctx, const Eigen::Vector2d& c) {
 
 void addLotExtras(WorldContext& ctx, const LotFrame& lot, double frontage, double setback,
                   const Footprint& fp) {
-  const RoadNetwork& roads = ctx.world.roads;
   // Driveway from the sidewalk to the garage door.
   const double dx = 0.5 * fp.parts[0].length - 2.0;
   const Eigen::Vector2d d0 = lot.at(dx, -setback), d1 = lot.at(dx, 0.0);
@@ -156,7 +155,6 @@ void addLotExtras(WorldContext& ctx, const LotFrame& lot, double frontage, doubl
   ctx.mesh.addGroundPolygon(
       {d0 - lot.along * 1.6, d0 + lot.along * 1.6, d1 + lot.along * 1.6, d1 - lot.along * 1.6},
       0.03, concrete);
-  (void)roads;
 
   // Hedge along the front of the lot, left of the driveway.
   if (ctx.rng.chance(0.4)) {

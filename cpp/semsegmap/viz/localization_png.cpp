@@ -1,6 +1,7 @@
 #include "semsegmap/viz/localization_png.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
@@ -17,6 +18,23 @@ cv::Scalar errorColor(double e) {
   if (e < 1.0) return {80, 220, 60};
   if (e < 5.0) return {0, 200.0 - 25.0 * e, 255};
   return {40, 40, 230};
+}
+
+// The title, the error colours at the bottom left and what the picture shows.
+void drawLegend(cv::Mat& canvas, const LocalizationPicture& pic, double mpp) {
+  drawLabel(canvas, pic.title, {12, 28}, 0.7);
+  const int y0 = canvas.rows - 20;
+  cv::circle(canvas, {20, y0 - 50}, 6, errorColor(0.5), cv::FILLED);
+  drawLabel(canvas, "error < 1 m", {32, y0 - 45}, 0.5);
+  cv::circle(canvas, {20, y0 - 30}, 6, errorColor(3.0), cv::FILLED);
+  drawLabel(canvas, "1-5 m", {32, y0 - 25}, 0.5);
+  cv::circle(canvas, {20, y0 - 10}, 6, errorColor(10.0), cv::FILLED);
+  drawLabel(canvas, "> 5 m", {32, y0 - 5}, 0.5);
+  char scale[96];
+  std::snprintf(scale, sizeof(scale),
+                "grey: %zu map segments; magenta: matches of one localization; %.2f m/px",
+                pic.map_centroids.size(), mpp);
+  drawLabel(canvas, scale, {12, 52}, 0.5);
 }
 
 }  // namespace
@@ -73,19 +91,7 @@ void writeLocalizationPng(const std::filesystem::path& png, const LocalizationPi
   if (!pic.matches.empty())
     cv::circle(canvas, px(pic.highlight.x(), pic.highlight.y()), 9, cv::Scalar(255, 255, 255), 2,
                cv::LINE_AA);
-  drawLabel(canvas, pic.title, {12, 28}, 0.7);
-  const int y0 = h - 20;
-  cv::circle(canvas, {20, y0 - 50}, 6, errorColor(0.5), cv::FILLED);
-  drawLabel(canvas, "error < 1 m", {32, y0 - 45}, 0.5);
-  cv::circle(canvas, {20, y0 - 30}, 6, errorColor(3.0), cv::FILLED);
-  drawLabel(canvas, "1-5 m", {32, y0 - 25}, 0.5);
-  cv::circle(canvas, {20, y0 - 10}, 6, errorColor(10.0), cv::FILLED);
-  drawLabel(canvas, "> 5 m", {32, y0 - 5}, 0.5);
-  char scale[96];
-  std::snprintf(scale, sizeof(scale),
-                "grey: %zu map segments; magenta: matches of one localization; %.2f m/px",
-                pic.map_centroids.size(), mpp);
-  drawLabel(canvas, scale, {12, 52}, 0.5);
+  drawLegend(canvas, pic, mpp);
   writePng(png, fromBgr(canvas));
 }
 

@@ -50,7 +50,7 @@ void writeSimOverview(const sim::WorldConfig& config, const std::filesystem::pat
     const sim::Trajectory t =
         sim::makeTrajectory(world.roads, r.run, sim::TrajectoryConfig{}, sim::OdometryNoise{}, 1);
     std::vector<cv::Point> pts;
-    for (const auto& T : t.T_world_base_gt) pts.push_back(toPixel(T.translation().head<2>()));
+    for (const auto& T : t.T_world_base) pts.push_back(toPixel(T.translation().head<2>()));
     cv::polylines(canvas, pts, false, r.bgr, 3, cv::LINE_AA);
     cv::arrowedLine(canvas, pts.front(), pts[std::min<size_t>(12, pts.size() - 1)], r.bgr, 3,
                     cv::LINE_AA, 0, 0.5);

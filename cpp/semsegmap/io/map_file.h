@@ -24,13 +24,4 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
 // one of another format version.
 TargetMap loadTargetMap(const std::filesystem::path& path);
 
-// Throws std::runtime_error "<path>: ..." when the map's descriptors cannot be compared with those
-// of the running describer (another descriptor kind, dimension or model).
-void checkMapCompatible(const std::filesystem::path& path, const TargetMap& map,
-                        const std::string& descriptor, const std::string& fingerprint,
-                        int dimension);
-
-// FNV-1a, 64 bit: every single-byte change changes it.
-uint64_t fnv1a64(const char* data, size_t size);
-
 }  // namespace semsegmap

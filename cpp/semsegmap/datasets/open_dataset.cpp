@@ -1,4 +1,4 @@
-#include "semsegmap/io/open_dataset.h"
+#include "semsegmap/datasets/open_dataset.h"
 
 #include <filesystem>
 #include <sstream>

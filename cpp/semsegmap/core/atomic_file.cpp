@@ -1,4 +1,4 @@
-#include "semsegmap/io/atomic_file.h"
+#include "semsegmap/core/atomic_file.h"
 
 #include <unistd.h>
 

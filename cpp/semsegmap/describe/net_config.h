@@ -1,0 +1,53 @@
+// What a learned descriptor network is, without torch: its configuration and, once trained, its
+// weights as plain values. Model files (io/model_file.h) store exactly this.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "semsegmap/describe/descriptor.h"
+
+namespace semsegmap {
+
+struct NetConfig {
+  DescriptorKind kind = DescriptorKind::kSemSegMapNet;
+  int descriptor_dim = 64;
+  int num_points = 512;  // semsegmap-net: random subsample (paper: 2048; semsegmap_net.h)
+  int num_classes = 16;  // class ids >= this count into the last bin
+  int grid_xy = 32;      // segmap-cnn occupancy grid
+  int grid_z = 16;
+  int recon_grid = 16;  // decoder output: recon_grid^3 occupancy (semsegmap-net)
+  // Channels of the first layer; the later ones are multiples (semsegmap_net.h, segmap_cnn.h).
+  // Chosen for the inference budget on a 2-core CPU (bench/bench_describe.cpp).
+  int pointnet_width = 16;  // semsegmap-net
+  int cnn_width = 32;       // segmap-cnn: SegMap's 32, 64, 64
+  // semsegmap-net's two set abstraction levels: num_points / divisor centres, each grouping at
+  // most sa_neighbours points within its radius (in the unit-scale frame of the input). Model
+  // files before format version 2 did not record these; every one was trained with these values.
+  int sa1_divisor = 4;
+  float sa1_radius = 0.2f;
+  int sa2_divisor = 16;
+  float sa2_radius = 0.4f;
+  int sa_neighbours = 16;
+};
+
+// Throws std::invalid_argument naming the field when a value is out of range (e.g. a grid size
+// the decoder cannot reach by doubling).
+void validateNetConfig(const NetConfig& config);
+
+struct ModelTensor {
+  std::string name;  // the module's parameter or buffer name
+  std::vector<int64_t> shape;
+  std::vector<float> values;  // row-major, product(shape) values
+};
+
+// A trained network: configuration, weights in the module's registration order, and the
+// fingerprint of both (describe/learned_net.h, netFingerprint).
+struct Model {
+  NetConfig config;
+  std::string fingerprint;  // 16 hex digits
+  std::vector<ModelTensor> tensors;
+};
+
+}  // namespace semsegmap

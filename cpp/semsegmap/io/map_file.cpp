@@ -1,0 +1,114 @@
+#include "semsegmap/io/map_file.h"
+
+#include <cstring>
+#include <stdexcept>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/binary_io.h"
+
+namespace semsegmap {
+
+namespace {
+
+constexpr std::string_view kMagic("SSMMAP\r\n", 8);
+constexpr uint32_t kFlagFloat16 = 1u << 0;
+constexpr uint32_t kFlagPoints = 1u << 1;
+
+void putHalf(BinaryWriter& w, float v) {
+  w.put(Eigen::numext::bit_cast<uint16_t>(Eigen::half(v)));
+}
+float getHalf(BinaryReader& r, const char* field) {
+  return static_cast<float>(
+      Eigen::half(Eigen::half_impl::raw_uint16_to_half(r.get<uint16_t>(field))));
+}
+
+}  // namespace
+
+uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
+                       const MapWriteOptions& options) {
+  if (static_cast<size_t>(map.descriptors.rows()) != map.segments.size())
+    throw std::invalid_argument(path.string() + ": map has " + std::to_string(map.segments.size()) +
+                                " segments but " + std::to_string(map.descriptors.rows()) +
+                                " descriptors");
+  bool points = false;
+  for (const MapSegment& s : map.segments) points = points || !s.points.empty();
+  BinaryWriter w;
+  w.putBytes(kMagic.data(), kMagic.size());
+  w.put<uint32_t>(kMapFormatVersion);
+  w.put<uint32_t>((options.float16 ? kFlagFloat16 : 0u) | (points ? kFlagPoints : 0u));
+  w.putString8(map.descriptor);
+  w.putString8(map.fingerprint);
+  w.put<uint32_t>(static_cast<uint32_t>(map.dimension()));
+  w.put<uint64_t>(map.segments.size());
+  for (size_t i = 0; i < map.segments.size(); ++i) {
+    const MapSegment& s = map.segments[i];
+    for (int k = 0; k < 3; ++k) w.put<float>(s.centroid[k]);
+    w.put<uint32_t>(s.n_points);
+    w.put<uint16_t>(s.majority_class);
+    for (int k = 0; k < map.dimension(); ++k) {
+      const float v = map.descriptors(static_cast<Eigen::Index>(i), k);
+      if (options.float16)
+        putHalf(w, v);
+      else
+        w.put<float>(v);
+    }
+  }
+  if (points)
+    for (const MapSegment& s : map.segments) {
+      if (s.points.size() > 65535) throw std::invalid_argument("more than 65535 picture points");
+      w.put<uint16_t>(static_cast<uint16_t>(s.points.size()));
+      // Offsets from the centroid: float16 keeps centimetres within tens of metres.
+      for (const Eigen::Vector3f& p : s.points)
+        for (int k = 0; k < 3; ++k) putHalf(w, p[k] - s.centroid[k]);
+    }
+  w.putChecksum();
+  writeBytesAtomically(path, w.bytes());
+  return w.bytes().size();
+}
+
+TargetMap loadTargetMap(const std::filesystem::path& path) {
+  const std::string bytes = readFileBytes(path);
+  BinaryReader r(path, bytes, "map file");
+  r.expectMagic(kMagic);
+  const uint32_t version = r.get<uint32_t>("the header");
+  if (version != kMapFormatVersion)
+    r.fail("map format version " + std::to_string(version) + ", this build reads version " +
+           std::to_string(kMapFormatVersion) + " (rebuild the map with `semsegmap map`)");
+  r.checksummed();
+  const uint32_t flags = r.get<uint32_t>("the header");
+  if (flags & ~(kFlagFloat16 | kFlagPoints))
+    r.fail("unknown header flags " + std::to_string(flags));
+  TargetMap map;
+  map.descriptor = r.getString8("the header");
+  map.fingerprint = r.getString8("the header");
+  const uint32_t dim = r.get<uint32_t>("the header");
+  if (dim == 0 || dim > 4096) r.fail("implausible descriptor dimension " + std::to_string(dim));
+  const size_t per_segment = 12 + 4 + 2 + dim * ((flags & kFlagFloat16) ? 2 : 4);
+  const uint64_t n = r.getCount(per_segment, "the segments");  // before allocating n of anything
+  map.segments.resize(n);
+  map.descriptors.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(dim));
+  for (size_t i = 0; i < n; ++i) {
+    MapSegment& s = map.segments[i];
+    for (int k = 0; k < 3; ++k) s.centroid[k] = r.get<float>("a segment");
+    s.n_points = r.get<uint32_t>("a segment");
+    s.majority_class = r.get<uint16_t>("a segment");
+    for (uint32_t k = 0; k < dim; ++k)
+      map.descriptors(static_cast<Eigen::Index>(i), k) =
+          (flags & kFlagFloat16) ? getHalf(r, "a descriptor") : r.get<float>("a descriptor");
+  }
+  if (flags & kFlagPoints)
+    for (MapSegment& s : map.segments) {
+      const size_t count = r.get<uint16_t>("the points");
+      r.need(count, 6, "the points");
+      s.points.resize(count);
+      for (Eigen::Vector3f& p : s.points)
+        for (int k = 0; k < 3; ++k) p[k] = s.centroid[k] + getHalf(r, "the points");
+    }
+  r.expectEnd("the segments");
+  return map;
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,144 @@
+#include "semsegmap/io/model_file.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/binary_io.h"
+#include "semsegmap/describe/learned_net.h"
+
+namespace semsegmap {
+
+namespace {
+
+constexpr std::string_view kMagic("SSMNET", 6);
+
+void putConfig(BinaryWriter& w, const NetConfig& c) {
+  for (const int32_t f : {c.descriptor_dim, c.num_points, c.num_classes, c.grid_xy, c.grid_z,
+                          c.recon_grid, c.pointnet_width, c.cnn_width})
+    w.put(f);
+  for (const int32_t f : {c.sa1_divisor, c.sa2_divisor, c.sa_neighbours}) w.put(f);
+  w.put(c.sa1_radius);
+  w.put(c.sa2_radius);
+}
+
+NetConfig getConfig(BinaryReader& r, DescriptorKind kind, uint32_t version) {
+  NetConfig c;  // version 1: the set abstraction defaults, which every version 1 model used
+  c.kind = kind;
+  for (int* f : {&c.descriptor_dim, &c.num_points, &c.num_classes, &c.grid_xy, &c.grid_z,
+                 &c.recon_grid, &c.pointnet_width, &c.cnn_width})
+    *f = r.get<int32_t>("the configuration");
+  if (version >= 2) {
+    for (int* f : {&c.sa1_divisor, &c.sa2_divisor, &c.sa_neighbours})
+      *f = r.get<int32_t>("the configuration");
+    c.sa1_radius = r.get<float>("the configuration");
+    c.sa2_radius = r.get<float>("the configuration");
+  }
+  try {
+    validateNetConfig(c);
+  } catch (const std::invalid_argument& e) {
+    r.fail(std::string("corrupt header: ") + e.what());
+  }
+  return c;
+}
+
+DescriptorKind getKind(BinaryReader& r, std::optional<DescriptorKind> expected) {
+  const std::string name = r.getString32("the header");
+  DescriptorKind kind;
+  try {
+    kind = parseDescriptorKind(name);
+  } catch (const std::invalid_argument& e) {
+    r.fail(std::string("corrupt header: ") + e.what());
+  }
+  if (expected && kind != *expected)
+    r.fail("holds a " + name + " model, expected " + descriptorName(*expected));
+  return kind;
+}
+
+ModelTensor getTensor(BinaryReader& r) {
+  ModelTensor t;
+  t.name = r.getString32("a tensor name");
+  const uint32_t rank = r.get<uint32_t>("a tensor shape");
+  if (rank > 8) r.fail("corrupt model file: tensor " + t.name + " of rank " + std::to_string(rank));
+  t.shape = r.getArray<int64_t>(rank, "a tensor shape");
+  size_t numel = 1;
+  for (const int64_t s : t.shape) {
+    if (s < 0 || s > (int64_t{1} << 31)) r.fail("corrupt model file: tensor " + t.name + " shape");
+    numel *= static_cast<size_t>(s);
+    r.need(numel, sizeof(float), "the weights");  // also bounds the product
+  }
+  t.values = r.getArray<float>(numel, "the weights");
+  return t;
+}
+
+}  // namespace
+
+void writeModelFile(const std::filesystem::path& path, const Model& model) {
+  BinaryWriter w;
+  w.putBytes(kMagic.data(), kMagic.size());
+  w.put(kModelFormatVersion);
+  w.putString32(descriptorName(model.config.kind));
+  putConfig(w, model.config);
+  if (model.fingerprint.size() != 16)
+    throw std::invalid_argument(path.string() + ": a model fingerprint has 16 hex digits");
+  w.putBytes(model.fingerprint.data(), model.fingerprint.size());
+  w.put(static_cast<uint64_t>(model.tensors.size()));
+  for (const ModelTensor& t : model.tensors) {
+    w.putString32(t.name);
+    w.put(static_cast<uint32_t>(t.shape.size()));
+    w.putArray(t.shape);
+    w.putArray(t.values);
+  }
+  writeBytesAtomically(path, w.bytes());
+}
+
+Model readModelFile(const std::filesystem::path& path, std::optional<DescriptorKind> expected) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    throw std::runtime_error(path.string() + ": cannot open model file (missing or not a file)");
+  const std::string bytes = readFileBytes(path);
+  BinaryReader r(path, bytes, "model file");
+  r.expectMagic(kMagic);
+  const uint32_t version = r.get<uint32_t>("the header");
+  if (version < 1 || version > kModelFormatVersion)
+    r.fail("model format version " + std::to_string(version) + ", this build reads versions 1.." +
+           std::to_string(kModelFormatVersion));
+  Model model;
+  const DescriptorKind kind = getKind(r, expected);
+  model.config = getConfig(r, kind, version);
+  model.fingerprint = std::string(r.take(16, "the fingerprint"), 16);
+  // A tensor takes at least its name's length, its rank and one float.
+  const uint64_t count = r.getCount(12, "the tensor count");
+  for (uint64_t i = 0; i < count; ++i) model.tensors.push_back(getTensor(r));
+  r.expectEnd("the weights");
+  return model;
+}
+
+void saveNet(const std::filesystem::path& path, DescriptorNetImpl& net) {
+  writeModelFile(path, modelOf(net));
+}
+
+std::shared_ptr<DescriptorNetImpl> loadNet(const std::filesystem::path& path,
+                                           std::optional<DescriptorKind> expected) {
+  const Model model = readModelFile(path, expected);
+  try {
+    return netFromModel(model);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path.string() + ": " + e.what());
+  }
+}
+
+std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int threads) {
+  const DescriptorKind kind = parseDescriptorKind(config.kind);
+  DescriberOptions options;
+  options.threads = threads;
+  if (kind == DescriptorKind::kSemSegMapNet || kind == DescriptorKind::kSegMapCnn) {
+    if (config.model.empty())
+      throw std::invalid_argument("descriptor.kind " + config.kind +
+                                  " needs a model file (descriptor.model)");
+    options.net = loadNet(config.model, kind);
+  }
+  return makeDescriber(kind, options);
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,292 @@
+// The command line as a user types it, through the built binary (its path is the first argument,
+// as for cli_eval.sh; run from the repository's root): --version, every command's own --help,
+// `--opt=value`, the exit codes of usage errors (2) and runtime errors (1), and progress that
+// stays free of '\r' when it goes to a file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "temp_dir.h"
+
+namespace semsegmap {
+namespace {
+
+using test_support::TempDir;
+
+std::string g_binary;  // set by main
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs `semsegmap ARGS` with stdout and stderr into files (so neither is a terminal).
+Result run(const std::string& args) {
+  static int counter = 0;
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const std::string stem =
+      "semsegmap_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
+  const std::filesystem::path out = dir / (stem + ".out"), err = dir / (stem + ".err");
+  const std::string command = "'" + g_binary + "' " + args + " > '" + out.string() + "' 2> '" +
+                              err.string() + "' < /dev/null";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = readFile(out);
+  r.err = readFile(err);
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return r;
+}
+
+struct CommandOptions {
+  std::string command;
+  std::vector<std::string> options;  // exactly the options its help must list (besides --help)
+  std::vector<std::string> foreign;  // options of other commands it must not list
+};
+
+const std::vector<CommandOptions> kCommands = {
+    {"simulate",
+     {"world-seed", "run", "condition", "traffic-seed", "max-frames", "world", "out", "no-cameras"},
+     {"dataset", "config"}},
+    {"simulate-overview",
+     {"world-seed", "world", "out", "cameras", "run", "frame"},
+     {"max-frames", "dataset"}},
+    {"enrich", {"dataset", "frame", "out", "ply", "camera"}, {"max-frames", "config"}},
+    {"convert", {"dataset", "out", "max-frames"}, {"config", "world-seed"}},
+    {"segment", {"dataset", "config", "out", "poses", "max-frames"}, {"map", "float32"}},
+    {"map",
+     {"dataset", "config", "out", "poses", "max-frames", "points", "float32"},
+     {"world-seed", "map"}},
+    {"localize", {"dataset", "config", "map", "out", "max-frames"}, {"poses", "float32"}},
+    {"slam", {"dataset", "config", "out", "max-frames"}, {"map", "poses"}},
+    {"train",
+     {"descriptor", "dataset", "out", "epochs", "batch", "threads", "config", "max-frames", "cache",
+      "anchors-per-epoch", "lr", "seed", "points", "history"},
+     {"world-seed", "map"}},
+    {"demo", {"out", "world-seed", "preset", "max-frames"}, {"configs", "dataset"}},
+    {"eval segmentation",
+     {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run"},
+     {"map-run", "descriptors", "config"}},
+    {"eval descriptors",
+     {"world-seed", "out", "preset", "max-frames", "config", "models", "descriptors", "threads",
+      "descriptor-run"},
+     {"configs", "map-run"}},
+    {"eval localization",
+     {"world-seed", "out", "preset", "max-frames", "configs", "map-run", "query-runs"},
+     {"descriptors", "segmentation-run"}},
+    {"eval paper",
+     {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run", "config",
+      "models", "descriptors", "threads", "descriptor-run", "map-run", "query-runs"},
+     {"dataset"}},
+};
+
+// The option lines of a help text: "  --name PLACEHOLDER  help" -> {"name", "PLACEHOLDER"}.
+std::vector<std::pair<std::string, std::string>> helpOptions(const std::string& help) {
+  std::vector<std::pair<std::string, std::string>> out;
+  std::istringstream in(help);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("  --", 0) != 0) continue;
+    const std::string head = line.substr(4, line.find("  ", 4) - 4);
+    const size_t space = head.find(' ');
+    out.emplace_back(head.substr(0, space),
+                     space == std::string::npos ? "" : head.substr(space + 1));
+  }
+  return out;
+}
+
+// `semsegmap COMMAND --help`, run once per command (each start of the binary takes a second).
+const Result& help(const std::string& command) {
+  static std::map<std::string, Result> cache;
+  auto it = cache.find(command);
+  if (it == cache.end()) it = cache.emplace(command, run(command + " --help")).first;
+  return it->second;
+}
+
+bool lists(const std::string& help, const std::string& option) {
+  for (const auto& [name, placeholder] : helpOptions(help))
+    if (name == option) return true;
+  return false;
+}
+
+TEST(Cli, Version) {
+  const Result r = run("--version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_TRUE(std::regex_match(r.out, std::regex("semsegmap [0-9]+\\.[0-9]+\\.[0-9]+\n"))) << r.out;
+  EXPECT_EQ(r.err, "");
+  const Result word = run("version");
+  EXPECT_EQ(word.code, 0);
+  EXPECT_EQ(word.out, r.out);
+}
+
+TEST(Cli, OverviewListsEveryCommand) {
+  const Result r = run("--help");
+  EXPECT_EQ(r.code, 0);
+  for (const CommandOptions& c : kCommands)
+    EXPECT_NE(r.out.find("\n  " + c.command + " "), std::string::npos) << c.command;
+  const Result none = run("");
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.err.find("usage: semsegmap <command>"), std::string::npos);
+}
+
+TEST(Cli, EveryCommandHasItsOwnHelp) {
+  for (const CommandOptions& c : kCommands) {
+    SCOPED_TRACE(c.command);
+    const Result& r = help(c.command);
+    EXPECT_EQ(r.code, 0);
+    EXPECT_EQ(r.err, "");
+    EXPECT_EQ(r.out.rfind("usage: semsegmap " + c.command + " ", 0), 0u) << r.out;
+    for (const std::string& o : c.options) EXPECT_TRUE(lists(r.out, o)) << "--" << o;
+    for (const std::string& o : c.foreign) EXPECT_FALSE(lists(r.out, o)) << "--" << o;
+    EXPECT_TRUE(lists(r.out, "help"));
+    EXPECT_EQ(helpOptions(r.out).size(), c.options.size() + 1) << r.out;
+  }
+  const Result eval = run("eval --help");
+  EXPECT_EQ(eval.code, 0);
+  for (const char* e : {"segmentation", "descriptors", "localization", "paper"})
+    EXPECT_NE(eval.out.find("eval " + std::string(e)), std::string::npos) << e;
+}
+
+TEST(Cli, HelpShowsDefaultsAndRequiredOptions) {
+  const Result& map = help("map");
+  EXPECT_NE(map.out.find("--points N"), std::string::npos);
+  EXPECT_NE(map.out.find("(default: 0)"), std::string::npos);
+  EXPECT_NE(map.out.find("(required)"), std::string::npos);
+  EXPECT_NE(help("demo").out.find("(default: demo_out)"), std::string::npos);
+  EXPECT_NE(help("simulate").out.find("--world full|small|tiny"), std::string::npos);
+  EXPECT_NE(help("train").out.find("--epochs N"), std::string::npos);
+}
+
+// Every option a help lists is accepted by the parser: given all of them (a value each) and then
+// an unknown one, the only complaint is about the unknown one.
+TEST(Cli, ParserAcceptsWhatTheHelpLists) {
+  for (const CommandOptions& c : kCommands) {
+    SCOPED_TRACE(c.command);
+    std::string args = c.command;
+    for (const auto& [name, placeholder] : helpOptions(help(c.command).out)) {
+      if (name == "help") continue;
+      args += " --" + name;
+      // A choice: its first value; anything else: "1" (a number, a name, a path).
+      if (placeholder.find('|') != std::string::npos)
+        args += " " + placeholder.substr(0, placeholder.find('|'));
+      else if (!placeholder.empty())
+        args += " 1";
+    }
+    const Result r = run(args + " --not-an-option");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("unknown option --not-an-option"), std::string::npos) << r.err;
+  }
+}
+
+TEST(Cli, UsageErrorsExitTwoWithAHint) {
+  const Result r = run("map --dataset d --config c --out o --world-seed 1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "semsegmap map: usage error: unknown option --world-seed\n"
+            "run 'semsegmap map --help' for its options\n");
+  const Result command = run("frobnicate");
+  EXPECT_EQ(command.code, 2);
+  EXPECT_NE(command.err.find("semsegmap: usage error: unknown command 'frobnicate'"),
+            std::string::npos);
+  const Result missing = run("map --dataset d --out o");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("missing required option --config"), std::string::npos);
+  const Result number = run("simulate --run S2 --out o --world-seed abc");
+  EXPECT_EQ(number.code, 2);
+  EXPECT_NE(number.err.find("--world-seed expects an integer, got 'abc'"), std::string::npos);
+  const Result choice = run("simulate --run S7 --out o");
+  EXPECT_EQ(choice.code, 2);
+  EXPECT_NE(choice.err.find("--run expects S0|S1|S2|S3, got 'S7'"), std::string::npos);
+  const Result flag = run("map --dataset d --config c --out o --float32=yes");
+  EXPECT_EQ(flag.code, 2);
+  EXPECT_NE(flag.err.find("option --float32 takes no value"), std::string::npos);
+  const Result eval = run("eval nonsense --out o");
+  EXPECT_EQ(eval.code, 2);
+  EXPECT_NE(eval.err.find("semsegmap eval: usage error: unknown experiment 'nonsense'"),
+            std::string::npos);
+  EXPECT_NE(eval.err.find("run 'semsegmap eval --help'"), std::string::npos);
+  const Result demo = run("demo --configs config/segmap.yaml");  // once accepted and ignored
+  EXPECT_EQ(demo.code, 2);
+  EXPECT_NE(demo.err.find("unknown option --configs"), std::string::npos);
+  const Result sub = run("eval localization --out o --bogus 1");
+  EXPECT_EQ(sub.code, 2);
+  EXPECT_NE(sub.err.find("semsegmap eval localization: usage error: unknown option --bogus"),
+            std::string::npos);
+}
+
+TEST(Cli, NegativeMaxFramesIsAUsageErrorEverywhere) {
+  for (const CommandOptions& c : kCommands) {
+    if (std::find(c.options.begin(), c.options.end(), "max-frames") == c.options.end()) continue;
+    SCOPED_TRACE(c.command);
+    const Result r = run(c.command + " --max-frames=-1");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err, "semsegmap " + c.command +
+                         ": usage error: option --max-frames must not be negative, got '-1'\n"
+                         "run 'semsegmap " +
+                         c.command + " --help' for its options\n");
+  }
+  const Result spaced = run("map --dataset d --config c --out o --max-frames -1");
+  EXPECT_EQ(spaced.code, 2);
+  EXPECT_NE(spaced.err.find("--max-frames must not be negative"), std::string::npos);
+}
+
+// `--opt=value` works as `--opt value` does; the progress of a run into a file is plain lines.
+TEST(Cli, EqualsFormAndProgressIntoAFile) {
+  TempDir tmp;
+  const std::filesystem::path out = tmp.path() / "sim";
+  const Result r =
+      run("simulate --world-seed=1 --run=S2 --world=tiny --max-frames=3 --out=" + out.string() +
+          " --no-cameras");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote 3 frames"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::is_directory(out));
+  EXPECT_EQ(r.err.find('\r'), std::string::npos);
+  EXPECT_NE(r.err.find("simulate S2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3/3"), std::string::npos) << r.err;
+  const auto lines = std::count(r.err.begin(), r.err.end(), '\n');
+  EXPECT_GE(lines, 1);
+  EXPECT_LE(lines, 11) << r.err;
+}
+
+TEST(Cli, RuntimeErrorsExitOne) {
+  TempDir tmp;
+  const std::string missing = (tmp.path() / "missing.map").string();
+  const Result r =
+      run("localize --dataset sim:world=1,run=S2,preset=tiny,frames=2 --config "
+          "config/semsegmap.yaml --map " +
+          missing + " --out " + (tmp.path() / "loc").string());
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(r.err.rfind("semsegmap localize: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("missing.map"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("usage error"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace semsegmap
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: test_cli PATH_TO_SEMSEGMAP [gtest options]\n");
+    return 2;
+  }
+  semsegmap::g_binary = argv[1];
+  return RUN_ALL_TESTS();
+}

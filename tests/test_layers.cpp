@@ -1,0 +1,118 @@
+// The layer rule of docs/architecture.md, checked on the sources: every folder of the library
+// includes only from the folders below it. In particular the stages never include io/ (file
+// formats) or sim/ (the simulator): they take and return plain values.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::set<std::string> kStages = {"enrich",   "local_map", "segment",  "describe",
+                                       "localize", "graph",     "pipeline", "learn"};
+
+std::set<std::string> with(std::set<std::string> s, const std::set<std::string>& more) {
+  s.insert(more.begin(), more.end());
+  return s;
+}
+
+// Folder -> the folders it may include from (its own is always allowed).
+std::map<std::string, std::set<std::string>> makeTable() {
+  const std::set<std::string> stages = {"core",     "enrich",   "local_map", "segment",
+                                        "describe", "localize", "graph"};
+  const std::set<std::string> below_io = with(stages, {"pipeline", "learn"});
+  const std::set<std::string> below_viz = with(below_io, {"io", "sim", "datasets"});
+  return {
+      {"core", {}},
+      {"sim", {"core"}},
+      {"enrich", {"core"}},
+      {"local_map", {"core"}},
+      {"segment", {"core", "local_map"}},
+      {"describe", {"core", "local_map", "segment"}},
+      {"localize", {"core"}},
+      {"graph", {"core"}},
+      {"pipeline", stages},
+      {"learn", with(stages, {"pipeline"})},
+      {"io", below_io},
+      {"datasets", with(below_io, {"io", "sim"})},
+      {"viz", below_viz},
+      {"eval", with(below_viz, {"viz"})},
+  };
+}
+
+const std::map<std::string, std::set<std::string>>& allowed() {
+  static const auto table = makeTable();
+  return table;
+}
+
+struct Violation {
+  std::string file, include;
+};
+
+std::vector<Violation> violations(const fs::path& root) {
+  const std::regex include_re(R"(^\s*#\s*include\s*[<"]semsegmap/([a-z_]+)/)");
+  std::vector<Violation> out;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    const fs::path& p = entry.path();
+    if (p.extension() != ".h" && p.extension() != ".cpp") continue;
+    const std::string folder = p.parent_path().filename().string();
+    const auto rule = allowed().find(folder);
+    if (rule == allowed().end()) {
+      out.push_back({p.string(), "(a folder the layer rule does not know)"});
+      continue;
+    }
+    std::ifstream in(p);
+    std::string line;
+    std::smatch m;
+    while (std::getline(in, line))
+      if (std::regex_search(line, m, include_re) && m[1] != folder && !rule->second.count(m[1]))
+        out.push_back({p.string(), line});
+  }
+  return out;
+}
+
+const fs::path kLibrary = fs::path(SEMSEGMAP_SOURCE_DIR) / "cpp" / "semsegmap";
+
+}  // namespace
+
+TEST(Layers, EveryFolderIncludesOnlyFromTheFoldersBelowIt) {
+  for (const Violation& v : violations(kLibrary)) ADD_FAILURE() << v.file << ": " << v.include;
+}
+
+TEST(Layers, StagesNeverIncludeIoOrSim) {
+  for (const std::string& stage : kStages) {
+    const auto& may = allowed().at(stage);
+    EXPECT_FALSE(may.count("io") || may.count("sim") || may.count("datasets")) << stage;
+  }
+}
+
+// The checker itself: a stage that includes io/ is caught.
+TEST(Layers, AStageIncludingIoIsCaught) {
+  const fs::path root = fs::temp_directory_path() / "semsegmap_test_layers";
+  fs::remove_all(root);
+  fs::create_directories(root / "segment");
+  std::ofstream(root / "segment" / "bad.cpp") << "#include \"semsegmap/io/map_file.h\"\n";
+  std::ofstream(root / "segment" / "good.cpp") << "#include \"semsegmap/core/pose.h\"\n";
+  const auto found = violations(root);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].file.find("bad.cpp"), std::string::npos);
+  fs::remove_all(root);
+}
+
+// One CMake library per folder, named after it.
+TEST(Layers, EveryFolderIsOneLibrary) {
+  std::ifstream cmake(kLibrary / "CMakeLists.txt");
+  const std::string text((std::istreambuf_iterator<char>(cmake)), {});
+  for (const auto& entry : fs::directory_iterator(kLibrary)) {
+    if (!entry.is_directory()) continue;
+    const std::string folder = entry.path().filename().string();
+    EXPECT_NE(text.find("semsegmap_library(" + folder + ")"), std::string::npos) << folder;
+    EXPECT_TRUE(allowed().count(folder)) << folder;
+  }
+}
