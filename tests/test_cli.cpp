@@ -1,7 +1,8 @@
 // The command line as a user types it, through the built binary (its path is the first argument,
 // as for cli_eval.sh; run from the repository's root): --version, every command's own --help,
 // `--opt=value`, the exit codes of usage errors (2) and runtime errors (1), and progress that
-// stays free of '\r' when it goes to a file.
+// stays free of '\r' when it goes to a file. A command the build leaves out (the SEMSEGMAP_WITH_*
+// options, passed to this test by tests/CMakeLists.txt) is not listed and says why in one line.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -61,7 +62,7 @@ struct CommandOptions {
   std::vector<std::string> foreign;  // options of other commands it must not list
 };
 
-const std::vector<CommandOptions> kCommands = {
+const std::vector<CommandOptions> kAllCommands = {
     {"simulate",
      {"world-seed", "run", "condition", "traffic-seed", "max-frames", "world", "out", "no-cameras"},
      {"dataset", "config"}},
@@ -96,6 +97,24 @@ const std::vector<CommandOptions> kCommands = {
       "models", "descriptors", "threads", "descriptor-run", "map-run", "query-runs"},
      {"dataset"}},
 };
+
+// Whether this build has a command: those of the simulator need SEMSEGMAP_WITH_SIM, train needs
+// SEMSEGMAP_WITH_TORCH.
+bool built(const std::string& command) {
+  if (command == "train") return SEMSEGMAP_WITH_TORCH;
+  if (command.rfind("simulate", 0) == 0 || command == "demo" || command.rfind("eval", 0) == 0)
+    return SEMSEGMAP_WITH_SIM;
+  return true;
+}
+
+std::vector<CommandOptions> builtCommands(bool wanted = true) {
+  std::vector<CommandOptions> out;
+  for (const CommandOptions& c : kAllCommands)
+    if (built(c.command) == wanted) out.push_back(c);
+  return out;
+}
+
+const std::vector<CommandOptions> kCommands = builtCommands();
 
 // The option lines of a help text: "  --name PLACEHOLDER  help" -> {"name", "PLACEHOLDER"}.
 std::vector<std::pair<std::string, std::string>> helpOptions(const std::string& help) {
@@ -141,9 +160,33 @@ TEST(Cli, OverviewListsEveryCommand) {
   EXPECT_EQ(r.code, 0);
   for (const CommandOptions& c : kCommands)
     EXPECT_NE(r.out.find("\n  " + c.command + " "), std::string::npos) << c.command;
+  // The commands the build leaves out are named after the list, not in it.
+  const std::string listed = r.out.substr(0, r.out.find("not in this build:"));
+  for (const CommandOptions& c : builtCommands(false)) {
+    EXPECT_EQ(listed.find("\n  " + c.command + " "), std::string::npos) << c.command;
+    EXPECT_NE(r.out.find("not in this build:"), std::string::npos);
+  }
   const Result none = run("");
   EXPECT_EQ(none.code, 2);
   EXPECT_NE(none.err.find("usage: semsegmap <command>"), std::string::npos);
+}
+
+// A command this build leaves out: one line naming the option that would bring it, exit 1, and
+// its --help says the same.
+TEST(Cli, CommandsNotInThisBuildSayWhyInOneLine) {
+  const std::vector<CommandOptions> absent = builtCommands(false);
+  if (absent.empty()) GTEST_SKIP() << "this build has every command";
+  for (const CommandOptions& c : absent) {
+    SCOPED_TRACE(c.command);
+    const std::string option = c.command == "train" ? "SEMSEGMAP_WITH_TORCH" : "SEMSEGMAP_WITH_SIM";
+    for (const std::string& args : {c.command + " --out o", c.command + " --help"}) {
+      const Result r = run(args);
+      EXPECT_EQ(r.code, 1) << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_NE(r.err.find("this build has no"), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find("reconfigure with -D" + option + "=ON"), std::string::npos) << r.err;
+    }
+  }
 }
 
 TEST(Cli, EveryCommandHasItsOwnHelp) {
@@ -158,6 +201,7 @@ TEST(Cli, EveryCommandHasItsOwnHelp) {
     EXPECT_TRUE(lists(r.out, "help"));
     EXPECT_EQ(helpOptions(r.out).size(), c.options.size() + 1) << r.out;
   }
+  if (!built("eval")) return;
   const Result eval = run("eval --help");
   EXPECT_EQ(eval.code, 0);
   for (const char* e : {"segmentation", "descriptors", "localization", "paper"})
@@ -169,9 +213,15 @@ TEST(Cli, HelpShowsDefaultsAndRequiredOptions) {
   EXPECT_NE(map.out.find("--points N"), std::string::npos);
   EXPECT_NE(map.out.find("(default: 0)"), std::string::npos);
   EXPECT_NE(map.out.find("(required)"), std::string::npos);
-  EXPECT_NE(help("demo").out.find("(default: demo_out)"), std::string::npos);
-  EXPECT_NE(help("simulate").out.find("--world full|small|tiny"), std::string::npos);
-  EXPECT_NE(help("train").out.find("--epochs N"), std::string::npos);
+  if (built("demo")) {
+    EXPECT_NE(help("demo").out.find("(default: demo_out)"), std::string::npos);
+  }
+  if (built("simulate")) {
+    EXPECT_NE(help("simulate").out.find("--world full|small|tiny"), std::string::npos);
+  }
+  if (built("train")) {
+    EXPECT_NE(help("train").out.find("--epochs N"), std::string::npos);
+  }
 }
 
 // Every option a help lists is accepted by the parser: given all of them (a value each) and then
@@ -208,15 +258,22 @@ TEST(Cli, UsageErrorsExitTwoWithAHint) {
   const Result missing = run("map --dataset d --out o");
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("missing required option --config"), std::string::npos);
+  const Result flag = run("map --dataset d --config c --out o --float32=yes");
+  EXPECT_EQ(flag.code, 2);
+  EXPECT_NE(flag.err.find("option --float32 takes no value"), std::string::npos);
+  const Result count = run("convert --dataset d --out o --max-frames abc");
+  EXPECT_EQ(count.code, 2);
+  EXPECT_NE(count.err.find("--max-frames expects an integer, got 'abc'"), std::string::npos);
+  const Result poses = run("segment --dataset d --config c --out o --poses nope");
+  EXPECT_EQ(poses.code, 2);
+  EXPECT_NE(poses.err.find("--poses expects "), std::string::npos) << poses.err;
+  if (!built("simulate")) return;
   const Result number = run("simulate --run S2 --out o --world-seed abc");
   EXPECT_EQ(number.code, 2);
   EXPECT_NE(number.err.find("--world-seed expects an integer, got 'abc'"), std::string::npos);
   const Result choice = run("simulate --run S7 --out o");
   EXPECT_EQ(choice.code, 2);
   EXPECT_NE(choice.err.find("--run expects S0|S1|S2|S3, got 'S7'"), std::string::npos);
-  const Result flag = run("map --dataset d --config c --out o --float32=yes");
-  EXPECT_EQ(flag.code, 2);
-  EXPECT_NE(flag.err.find("option --float32 takes no value"), std::string::npos);
   const Result eval = run("eval nonsense --out o");
   EXPECT_EQ(eval.code, 2);
   EXPECT_NE(eval.err.find("semsegmap eval: usage error: unknown experiment 'nonsense'"),
@@ -249,6 +306,7 @@ TEST(Cli, NegativeMaxFramesIsAUsageErrorEverywhere) {
 
 // `--opt=value` works as `--opt value` does; the progress of a run into a file is plain lines.
 TEST(Cli, EqualsFormAndProgressIntoAFile) {
+  if (!built("simulate")) GTEST_SKIP() << "this build has no simulator (SEMSEGMAP_WITH_SIM=OFF)";
   TempDir tmp;
   const std::filesystem::path out = tmp.path() / "sim";
   const Result r =
@@ -263,6 +321,36 @@ TEST(Cli, EqualsFormAndProgressIntoAFile) {
   const auto lines = std::count(r.err.begin(), r.err.end(), '\n');
   EXPECT_GE(lines, 1);
   EXPECT_LE(lines, 11) << r.err;
+}
+
+// A dataset or descriptor the build left out: one line naming the option, exit 1.
+TEST(Cli, PartsNotInThisBuildSayWhyInOneLine) {
+  if (SEMSEGMAP_WITH_SIM && SEMSEGMAP_WITH_TORCH && SEMSEGMAP_WITH_PCL)
+    GTEST_SKIP() << "this build has every part";
+  TempDir tmp;
+  auto expectOneLine = [](const Result& r, const std::string& command, const std::string& why) {
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(r.err.rfind("semsegmap " + command + ": error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  };
+  const std::string out = " --out " + (tmp.path() / "out").string();
+  if (!SEMSEGMAP_WITH_SIM)
+    expectOneLine(run("segment --dataset sim:world=1,run=S2 --config config/segmap.yaml" + out),
+                  "segment",
+                  "this build has no simulator (built without Embree, reconfigure with "
+                  "-DSEMSEGMAP_WITH_SIM=ON)");
+  if (!SEMSEGMAP_WITH_TORCH)
+    expectOneLine(run("map --dataset missing --config config/semsegmap.yaml" + out), "map",
+                  "descriptor.kind semsegmap-net: this build has no learned descriptors (built "
+                  "without libtorch, reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)");
+  if (!SEMSEGMAP_WITH_PCL) {
+    const std::filesystem::path config = tmp.path() / "fpfh.yaml";
+    std::ofstream(config) << "descriptor:\n  kind: fpfh\n";
+    expectOneLine(run("map --dataset missing --config " + config.string() + out), "map",
+                  "descriptor.kind fpfh: this build has no FPFH (built without PCL, reconfigure "
+                  "with -DSEMSEGMAP_WITH_PCL=ON)");
+  }
 }
 
 TEST(Cli, RuntimeErrorsExitOne) {

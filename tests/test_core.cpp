@@ -2,9 +2,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <set>
+#include <stdexcept>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/binary_io.h"
 #include "semsegmap/core/class_table.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/core/pose.h"
@@ -137,4 +140,78 @@ TEST(SensorRig, ValidateNamesTheBadField) {
   rig = defaultSimRig();
   rig.cameras[0].T_camera_lidar.linear() *= 2.0;
   EXPECT_THROW(rig.validate(), std::invalid_argument);
+}
+
+// ---- The binary reader and writer of every file format ------------------------------------------
+
+namespace {
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+}  // namespace
+
+TEST(BinaryIo, RoundTripOfValuesStringsAndArrays) {
+  BinaryWriter w;
+  w.putBytes("MAGIC", 5);
+  w.put<uint32_t>(7);
+  w.putString8("short");
+  w.putString32(std::string(300, 'x'));
+  w.putArray(std::vector<float>{1.5f, -2.0f});
+  w.putChecksum();
+  const std::string bytes = w.take();
+  BinaryReader r("f.bin", bytes, "test file");
+  r.expectMagic("MAGIC");
+  r.checksummed();
+  EXPECT_EQ(r.get<uint32_t>("a"), 7u);
+  EXPECT_EQ(r.getString8("b"), "short");
+  EXPECT_EQ(r.getString32("c"), std::string(300, 'x'));
+  EXPECT_EQ(r.getArray<float>(2, "d"), (std::vector<float>{1.5f, -2.0f}));
+  EXPECT_NO_THROW(r.expectEnd("d"));
+  EXPECT_THROW(BinaryWriter().putString8(std::string(256, 'x')), std::invalid_argument);
+}
+
+TEST(BinaryIo, ErrorsNameTheFileAndTheField) {
+  BinaryWriter w;
+  w.put<uint64_t>(1000000);  // a count far beyond the rest of the file
+  w.put<uint16_t>(3);
+  const std::string bytes = w.take();
+  {
+    BinaryReader r("/x/m.map", bytes, "map file");
+    const std::string e = errorOf([&] { r.getCount(4, "the segments"); });
+    EXPECT_NE(e.find("/x/m.map: corrupt map file (the segments"), std::string::npos) << e;
+  }
+  {
+    BinaryReader r("/x/m.map", bytes, "map file");
+    r.get<uint64_t>("the header");
+    const std::string e = errorOf([&] { r.get<uint32_t>("a descriptor"); });
+    EXPECT_EQ(e, "/x/m.map: truncated map file (ends inside a descriptor)");
+    EXPECT_EQ(r.position(), 8u);  // a failed read consumes nothing
+  }
+  {
+    BinaryReader r("/x/m.map", bytes, "map file");
+    EXPECT_NE(errorOf([&] { r.expectMagic("SSMMAP"); }).find("bad magic"), std::string::npos);
+  }
+  {
+    std::string corrupt = bytes + std::string(8, '\0');
+    BinaryReader r("/x/m.map", corrupt, "map file");
+    EXPECT_NE(errorOf([&] { r.checksummed(); }).find("checksum mismatch"), std::string::npos);
+  }
+  {
+    BinaryReader r("/x/m.map", bytes, "map file");
+    r.get<uint64_t>("the header");
+    EXPECT_NE(errorOf([&] { r.expectEnd("the header"); }).find("trailing bytes"),
+              std::string::npos);
+  }
+}
+
+TEST(BinaryIo, Fnv1aIsTheStandardHash) {
+  EXPECT_EQ(fnv1a64("", 0), 0xcbf29ce484222325ull);
+  EXPECT_EQ(fnv1a64("a", 1), 0xaf63dc4c8601ec8cull);
+  // Chained: the hash of two parts equals the hash of their concatenation.
+  EXPECT_EQ(fnv1a64("b", 1, fnv1a64("a", 1)), fnv1a64("ab", 2));
 }

@@ -1,6 +1,7 @@
 // The hand-made baseline descriptors: eigenvalue features against hand-computed textbook values,
 // FPFH against shapes it must tell apart, and the properties any segment descriptor needs
-// (invariance to point order and rigid motion, finite output, batch = one at a time).
+// (invariance to point order and rigid motion, finite output, batch = one at a time); and the
+// factory, which says in one line which option a kind missing from this build needs.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +13,10 @@
 
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/describe/eigen_descriptor.h"
+#if SEMSEGMAP_WITH_PCL
 #include "semsegmap/describe/fpfh_descriptor.h"
+#endif
+#include "semsegmap/io/model_file.h"
 
 using namespace semsegmap;
 namespace ef = semsegmap::eigen_feature;
@@ -123,9 +127,11 @@ void expectNear(const Features7& got, const Features7& want, double tol) {
   for (int i = 0; i < 7; ++i) EXPECT_NEAR(got(i), want(i), tol) << "feature " << i;
 }
 
+#if SEMSEGMAP_WITH_PCL
 double l1(const Features33& a, const Features33& b) {
   return (a - b).cwiseAbs().sum();
 }
+#endif
 
 }  // namespace
 
@@ -254,6 +260,53 @@ TEST(EigenDescriber, BatchGivesOneRowPerInput) {
   EXPECT_THROW(d.describe({DescriptorInput{}}), std::invalid_argument);
 }
 
+// The factory makes every kind this build has; for one it has not, the error is one line that
+// names the build option (by kind, and by descriptor.kind from a configuration).
+TEST(DescriberFactory, MakesTheKindsOfThisBuildAndNamesTheOptionOfTheOthers) {
+  EXPECT_EQ(makeDescriber(DescriptorKind::kEigen, {})->kind(), DescriptorKind::kEigen);
+  EXPECT_EQ(descriptorNotBuilt(DescriptorKind::kEigen), "");
+  auto expectMissing = [](DescriptorKind kind, const std::string& option) {
+    SCOPED_TRACE(descriptorName(kind));
+    const std::string why = descriptorNotBuilt(kind);
+    EXPECT_NE(why.find("this build has no"), std::string::npos) << why;
+    EXPECT_NE(why.find("reconfigure with -D" + option + "=ON"), std::string::npos) << why;
+    EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+    try {
+      makeDescriber(kind, {});
+      ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(e.what(), descriptorName(kind) + ": " + why);
+    }
+    DescriptorConfig config;
+    config.kind = descriptorName(kind);
+    config.model = "missing.model";  // never read
+    try {
+      makeDescriber(config);
+      ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(e.what(), "descriptor.kind " + config.kind + ": " + why);
+    }
+    EXPECT_THROW(requireDescriberBuilt(config), std::runtime_error);
+  };
+  if (SEMSEGMAP_WITH_PCL) {
+    DescriptorConfig fpfh;
+    fpfh.kind = "fpfh";
+    EXPECT_EQ(makeDescriber(fpfh, 1)->kind(), DescriptorKind::kFpfh);
+  } else {
+    expectMissing(DescriptorKind::kFpfh, "SEMSEGMAP_WITH_PCL");
+    EXPECT_NE(descriptorNotBuilt(DescriptorKind::kFpfh).find("no FPFH (built without PCL"),
+              std::string::npos);
+  }
+  for (const DescriptorKind kind : {DescriptorKind::kSegMapCnn, DescriptorKind::kSemSegMapNet}) {
+    if (SEMSEGMAP_WITH_TORCH) {
+      EXPECT_THROW(makeDescriber(kind, {}), std::invalid_argument);  // needs a network
+    } else {
+      expectMissing(kind, "SEMSEGMAP_WITH_TORCH");
+    }
+  }
+}
+
+#if SEMSEGMAP_WITH_PCL
 TEST(FpfhFeatures, BlocksSumToOne) {
   const Features33 f = fpfhFeatures(sphereShell(600, 1.0, 0.01, 10));
   ASSERT_TRUE(f.allFinite());
@@ -343,3 +396,4 @@ TEST(FpfhDescriber, RejectsBadConfig) {
   c.threads = -1;
   EXPECT_THROW(FpfhDescriber{c}, std::invalid_argument);
 }
+#endif  // SEMSEGMAP_WITH_PCL

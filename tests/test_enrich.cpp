@@ -15,6 +15,7 @@
 
 #include <Eigen/Dense>
 
+#include "build_options.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/enrich/enricher.h"
@@ -592,7 +593,21 @@ TEST(EnrichKitti, ColoursMatchTheDevkitProjection) {
 // ---------------------------------------------------------------------------------------------
 // Simulation end to end: camera classes on the points against the LiDAR's ground truth
 
+#if !SEMSEGMAP_WITH_SIM
+TEST(EnrichSim, ABuildWithoutTheSimulatorSaysSoInOneLine) {
+  try {
+    openDataset("sim:world=1,run=S2,preset=tiny");
+    ADD_FAILURE() << "a sim: dataset opened without the simulator";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(),
+                 "dataset 'sim:world=1,run=S2,preset=tiny': this build has no simulator (built "
+                 "without Embree, reconfigure with -DSEMSEGMAP_WITH_SIM=ON)");
+  }
+}
+#endif
+
 TEST(EnrichSim, CameraClassesAgreeWithGroundTruthPointLabels) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
   auto source = openDataset("sim:world=1,run=S2,preset=tiny,frames=3");
   ASSERT_EQ(source->size(), 3u);
   ASSERT_EQ(source->info().rig.cameras.size(), 3u);

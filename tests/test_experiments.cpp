@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "build_options.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/eval/localization_metrics.h"
@@ -101,6 +102,8 @@ TEST(SegmentationExperiment, HistogramAndRelativeChange) {
 
 // All three experiments on the tiny world (a few frames each), then the report that links them.
 TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  SEMSEGMAP_SKIP_WITHOUT_TORCH();  // the shipped configurations' descriptors are learned
   TempDir tmp;
   const std::filesystem::path out = tmp.path();
 

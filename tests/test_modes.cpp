@@ -1,6 +1,8 @@
 // The pipeline's modes end to end on the tiny simulated world: build a target map, save and load
 // it, localize another run against it, and close the loop of a drifting run. An oracle describer
 // (a descriptor from the ground-truth instance) isolates the wiring from descriptor quality.
+// Without the simulator only the real KITTI sample runs, with the eigenvalue descriptor when the
+// build has no libtorch.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -8,6 +10,7 @@
 #include <optional>
 #include <random>
 
+#include "build_options.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/graph/trajectory.h"
 #include "semsegmap/io/config.h"
@@ -48,6 +51,7 @@ PipelineConfig semsegmapConfig() {
 }
 
 TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
   const PipelineConfig config = semsegmapConfig();
   const auto oracle = std::make_shared<OracleDescriber>();
   auto mapping = openDataset("sim:world=1,run=S2,preset=tiny,frames=60");
@@ -88,6 +92,7 @@ TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {
 }
 
 TEST(Modes, LocalizationRefusesAMapOfAnotherModel) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
   const auto oracle = std::make_shared<OracleDescriber>();
   auto map = std::make_shared<TargetMap>();
   map->descriptor = "eigen";
@@ -100,10 +105,11 @@ TEST(Modes, LocalizationRefusesAMapOfAnotherModel) {
 // The real-data configuration on the ten real KITTI frames (no labels, no poses): the map of the
 // drive localizes the same drive again, with the 7 inliers the paper asks for on real data, at
 // the identity (odometry is the identity without oxts). The descriptors are the shipped model's,
-// trained on simulated data only.
+// trained on simulated data only; in a build without libtorch, the eigenvalue features.
 TEST(Modes, RealDataConfigMapsAndLocalizesTheKittiSample) {
-  const PipelineConfig config =
+  PipelineConfig config =
       loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap-kitti.yaml");
+  if (!SEMSEGMAP_WITH_TORCH) config.descriptor = DescriptorConfig{"eigen", "", 64};
   EXPECT_EQ(config.localization.localizer.verification.min_inliers, 7);
   const std::string spec = std::string("kitti-raw:") + SEMSEGMAP_SHARED_DATA +
                            "/kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
@@ -128,6 +134,7 @@ TEST(Modes, RealDataConfigMapsAndLocalizesTheKittiSample) {
 }
 
 TEST(Modes, LoopClosureRemovesOdometryDriftOnALoop) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
   PipelineConfig config = semsegmapConfig();
   // The tiny world's block is smaller than the local map: with the default 50 m radius the start
   // of the loop would never leave the local map, so there would be nothing to close.

@@ -124,7 +124,7 @@ TEST(MapFile, AnotherFormatVersionIsRejectedWithItsNumber) {
   const uint32_t other = kMapFormatVersion + 1;
   std::memcpy(&bytes[8], &other, sizeof(other));
   // Re-sign, so that only the version is wrong.
-  const uint64_t sum = fnv1a64(bytes.data(), bytes.size() - 8);
+  const uint64_t sum = fnv1a64(bytes.data(), bytes.size() - 8, kProjectFnvSeed);
   std::memcpy(&bytes[bytes.size() - 8], &sum, sizeof(sum));
   writeBytesAtomically(path, bytes);
   const std::string error = expectLoadError(path);

@@ -131,8 +131,13 @@ OptionSpec maxFramesOption(const std::string& help) {
 }
 
 const char* const kDatasetNotes =
+#if SEMSEGMAP_WITH_SIM
     "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,\n"
     "  sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small]\n";
+#else
+    "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH\n"
+    "  (not sim:, this build has no simulator: reconfigure with -DSEMSEGMAP_WITH_SIM=ON)\n";
+#endif
 
 std::string commandOverview(const std::vector<const CommandSpec*>& commands) {
   const size_t indent = 21, width = 100;

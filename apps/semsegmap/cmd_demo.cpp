@@ -11,6 +11,7 @@
 #include "resources.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/report.h"
+#include "semsegmap/io/model_file.h"
 #include "semsegmap/sim/simulator.h"
 #include "semsegmap/viz/sim_overview.h"
 
@@ -21,14 +22,17 @@ namespace {
 int runDemo(const CliArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   const std::filesystem::path out = a.get("out");
-  std::filesystem::create_directories(out);
 
   LocalizationExperimentConfig config;
   config.world_seed = a.getCount("world-seed");
   config.preset = a.get("preset");
   config.max_frames = a.frameLimit();
-  for (const char* name : {"config/semsegmap.yaml", "config/segmap.yaml"})
+  for (const char* name : {"config/semsegmap.yaml", "config/segmap.yaml"}) {
     config.configs.push_back(loadNamedConfig(shippedFile(name)));
+    // Their learned descriptors need libtorch: a build without it says so before it starts.
+    requireDescriberBuilt(config.configs.back().config.descriptor, name);
+  }
+  std::filesystem::create_directories(out);
 
   std::cout << "semsegmap demo: world " << config.world_seed << " (" << config.preset
             << "), map S0, localize S2 (sunny) and S3 (sunrise) with SemSegMap and SegMap\n";

@@ -12,6 +12,7 @@
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/eval/report.h"
+#include "semsegmap/io/model_file.h"
 
 namespace semsegmap::app {
 
@@ -35,17 +36,31 @@ std::vector<std::string> runList(const CliArgs& a, const std::string& name) {
   return runs;
 }
 
-// --descriptors: a list of descriptor names, checked before any experiment starts.
+// --descriptors: a list of descriptor names, checked before any experiment starts: a name that
+// is none is a usage error, one this build does not have (descriptorNotBuilt) a runtime error.
 std::vector<std::string> descriptorList(const CliArgs& a) {
   const std::vector<std::string> names = splitList(a.get("descriptors"));
   for (const std::string& name : names) {
+    DescriptorKind kind = DescriptorKind::kEigen;
     try {
-      parseDescriptorKind(name);
+      kind = parseDescriptorKind(name);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("option --descriptors: ") + e.what());
     }
+    const std::string missing = descriptorNotBuilt(kind);
+    if (!missing.empty())
+      throw std::runtime_error("option --descriptors: " + name + ": " + missing);
   }
   return names;
+}
+
+// The default of --descriptors: every descriptor this build has, the learned ones first.
+std::string builtDescriptors() {
+  std::string list;
+  for (const DescriptorKind kind : {DescriptorKind::kSemSegMapNet, DescriptorKind::kSegMapCnn,
+                                    DescriptorKind::kFpfh, DescriptorKind::kEigen})
+    if (descriptorNotBuilt(kind).empty()) list += (list.empty() ? "" : ",") + descriptorName(kind);
+  return list;
 }
 
 // The configurations compared: SemSegMap first, the SegMap baseline second.
@@ -91,6 +106,9 @@ LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   c.query_runs = runList(a, "query-runs");
   c.max_frames = a.frameLimit();
   c.configs = comparedConfigs(a);
+  // A describer this build does not have fails here, before the first frame.
+  for (const NamedConfig& config : c.configs)
+    requireDescriberBuilt(config.config.descriptor, config.path.string());
   return c;
 }
 
@@ -167,8 +185,8 @@ const OptionSpec kConfig{
     "the configuration that cuts the descriptor run into segments (default: shipped)"};
 const OptionSpec kModels{"models", Value::kText, "DIR", "models",
                          "folder of the learned descriptors' models (default: the shipped models)"};
-const OptionSpec kDescriptors{"descriptors", Value::kText, "LIST",
-                              "semsegmap-net,segmap-cnn,fpfh,eigen", "the descriptors compared"};
+const OptionSpec kDescriptors{"descriptors", Value::kText, "LIST", builtDescriptors(),
+                              "the descriptors compared, of those this build has"};
 const OptionSpec kThreads{"threads", Value::kCount, "N", "0",
                           "threads that describe segments, 0: all cores"};
 const OptionSpec kMapRun{"map-run", Value::kText, "S0|S1|S2|S3", "S0",

@@ -20,13 +20,14 @@ int runMap(const CliArgs& a) {
   if (points > 65535)
     throw UsageError("option --points must be in 0..65535, got " + a.get("points"));
   PipelineConfig config = loadPipelineConfig(a.get("config"));
+  // The model first: a missing one, or a descriptor this build has not, fails before the data.
+  std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
   const std::filesystem::path out = a.get("out");
   auto source = openDataset(a.get("dataset"));
   const std::string poses = a.has("poses")                          ? a.get("poses")
                             : source->info().has_ground_truth_poses ? "gt"
                                                                     : "odom";
   config.target_map.max_points_per_segment = points;
-  std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
 
   Progress progress("map", 0);
   RunOptions options;

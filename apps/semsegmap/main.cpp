@@ -1,6 +1,7 @@
 // semsegmap: the command line. Each subcommand lives in its own cmd_*.cpp with the table of its
 // options; usage errors exit 2 with a hint to the command's help, runtime errors (files, data)
-// print one line and exit 1.
+// print one line and exit 1. A command this build leaves out (the SEMSEGMAP_WITH_* options of
+// CMakeLists.txt) is not listed, and asking for it prints one line that says why and exits 1.
 #include <algorithm>
 #include <exception>
 #include <iostream>
@@ -17,30 +18,78 @@ namespace semsegmap::app {
 namespace {
 
 const std::vector<const CommandSpec*>& commands() {
-  static const std::vector<const CommandSpec*> all = {
-      &simulateCommand(), &simulateOverviewCommand(),
-      &enrichCommand(),   &convertCommand(),
-      &segmentCommand(),  &mapCommand(),
-      &localizeCommand(), &slamCommand(),
-      &trainCommand(),    &demoCommand()};
+  static const std::vector<const CommandSpec*> all = [] {
+    std::vector<const CommandSpec*> c;
+#if SEMSEGMAP_WITH_SIM
+    c = {&simulateCommand(), &simulateOverviewCommand()};
+#endif
+    c.insert(c.end(), {&enrichCommand(), &convertCommand(), &segmentCommand(), &mapCommand(),
+                       &localizeCommand(), &slamCommand()});
+#if SEMSEGMAP_WITH_TORCH
+    c.push_back(&trainCommand());
+#endif
+#if SEMSEGMAP_WITH_SIM
+    c.push_back(&demoCommand());
+#endif
+    return c;
+  }();
   return all;
 }
 
+// A command this build leaves out: its first word, the option that would bring it, and why.
+struct AbsentCommand {
+  std::string name, option, why;
+};
+
+const std::vector<AbsentCommand>& absentCommands() {
+  static const std::vector<AbsentCommand> absent = [] {
+    std::vector<AbsentCommand> a;
+    if (!SEMSEGMAP_WITH_SIM)
+      for (const char* name : {"simulate", "simulate-overview", "eval", "demo"})
+        a.push_back({name, "SEMSEGMAP_WITH_SIM",
+                     "this build has no simulator (built without Embree, reconfigure with "
+                     "-DSEMSEGMAP_WITH_SIM=ON)"});
+    if (!SEMSEGMAP_WITH_TORCH)
+      a.push_back({"train", "SEMSEGMAP_WITH_TORCH",
+                   "this build has no learned descriptors to train (built without libtorch, "
+                   "reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)"});
+    return a;
+  }();
+  return absent;
+}
+
+// "not in this build:" and a line per option: "  simulate, eval (SEMSEGMAP_WITH_SIM=OFF)"; or
+// nothing.
+std::string absentNote() {
+  std::string note, option;
+  for (const AbsentCommand& c : absentCommands()) {
+    if (c.option != option && !option.empty()) note += " (" + option + "=OFF)\n";
+    note += (c.option == option ? ", " : "  ") + c.name;
+    option = c.option;
+  }
+  return note.empty() ? "" : "\nnot in this build:\n" + note + " (" + option + "=OFF)\n";
+}
+
 std::string overview() {
-  std::vector<const CommandSpec*> listed = commands();  // the experiments before the demo
+  std::vector<const CommandSpec*> listed = commands();
+#if SEMSEGMAP_WITH_SIM
+  // The experiments before the demo.
   listed.insert(std::find(listed.begin(), listed.end(), &demoCommand()), evalCommands().begin(),
                 evalCommands().end());
+#endif
   return "usage: semsegmap <command> [options]\n       semsegmap --version\n\ncommands:\n" +
-         commandOverview(listed) + "\n" + kDatasetNotes +
+         commandOverview(listed) + absentNote() + "\n" + kDatasetNotes +
          "\nrun 'semsegmap <command> --help' for a command's options and their defaults.\n";
 }
 
+#if SEMSEGMAP_WITH_SIM
 std::string evalOverview() {
   return "usage: semsegmap eval <experiment> [options]\n\nthe paper's experiments, SemSegMap "
          "against SegMap on the same frames\n\nexperiments:\n" +
          commandOverview(evalCommands()) +
          "\nrun 'semsegmap eval <experiment> --help' for an experiment's options.\n";
 }
+#endif
 
 bool asksForHelp(const std::vector<std::string>& args) {
   for (const std::string& a : args)
@@ -57,6 +106,7 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
     return c;
   }
   if (args[0] != "eval") throw UsageError("unknown command '" + args[0] + "'");
+#if SEMSEGMAP_WITH_SIM
   *name = "eval";
   const std::string expected = "segmentation, descriptors, localization or paper";
   if (args.size() < 2 || args[1].rfind("-", 0) == 0)
@@ -67,6 +117,9 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
     return c;
   }
   throw UsageError("unknown experiment '" + args[1] + "' (expected " + expected + ")");
+#else
+  throw std::logic_error("eval is not in this build; run() answers it");
+#endif
 }
 
 int usageError(const std::string& name, const std::string& message) {
@@ -77,10 +130,17 @@ int usageError(const std::string& name, const std::string& message) {
 }
 
 int run(const std::vector<std::string>& args) {
+  for (const AbsentCommand& c : absentCommands()) {
+    if (args[0] != c.name) continue;
+    std::cerr << "semsegmap " << c.name << ": error: " << c.why << "\n";
+    return 1;
+  }
+#if SEMSEGMAP_WITH_SIM
   if (args[0] == "eval" && args.size() > 1 && (args[1] == "--help" || args[1] == "-h")) {
     std::cout << evalOverview();
     return 0;
   }
+#endif
   std::string name;
   try {
     const CommandSpec* command = findCommand(args, &name);

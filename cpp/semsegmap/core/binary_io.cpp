@@ -74,7 +74,7 @@ void BinaryReader::checksummed() {
   end_ -= sizeof(uint64_t);
   uint64_t stored;
   std::memcpy(&stored, bytes_.data() + end_, sizeof stored);
-  if (fnv1a64(bytes_.data(), end_) != stored)
+  if (fnv1a64(bytes_.data(), end_, kProjectFnvSeed) != stored)
     fail("checksum mismatch: the " + format_ + " is truncated or corrupt");
 }
 

@@ -16,8 +16,16 @@ namespace semsegmap {
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the file formats are little-endian");
 
-// FNV-1a, 64 bit: the checksum of the file formats (corruption, not tampering).
-uint64_t fnv1a64(const void* data, size_t size, uint64_t seed = 1469598103934665603ull);
+// FNV-1a, 64 bit, from the standard offset basis or from `seed` (chaining: the hash of b after a
+// equals the hash of a + b).
+constexpr uint64_t kFnvOffsetBasis = 14695981039346656037ull;
+uint64_t fnv1a64(const void* data, size_t size, uint64_t seed = kFnvOffsetBasis);
+
+// The start of the file formats' checksums and of the training split's object keys: the standard
+// basis with its last digit lost when the first map files were written. It is as good a start
+// for catching corruption, and changing it would refuse every saved map and move objects between
+// training and validation, so it stays.
+constexpr uint64_t kProjectFnvSeed = 1469598103934665603ull;
 
 class BinaryWriter {
  public:
@@ -38,7 +46,7 @@ class BinaryWriter {
   void putString8(const std::string& s);
   void putString32(const std::string& s);
   // Appends the FNV-1a of every byte so far (readers check it with BinaryReader::checksummed).
-  void putChecksum() { put<uint64_t>(fnv1a64(bytes_.data(), bytes_.size())); }
+  void putChecksum() { put<uint64_t>(fnv1a64(bytes_.data(), bytes_.size(), kProjectFnvSeed)); }
 
   const std::string& bytes() const { return bytes_; }
   std::string take() { return std::move(bytes_); }

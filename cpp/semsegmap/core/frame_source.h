@@ -30,4 +30,9 @@ class FrameSource {
   virtual Frame frame(size_t index) = 0;
 };
 
+// How many frames a run reads of `source`: the first max_frames, or all when it is 0.
+inline size_t framesToRead(const FrameSource& source, size_t max_frames) {
+  return max_frames > 0 && max_frames < source.size() ? max_frames : source.size();
+}
+
 }  // namespace semsegmap

@@ -8,12 +8,15 @@
 #include "semsegmap/io/kitti_raw_reader.h"
 #include "semsegmap/io/nclt_reader.h"
 #include "semsegmap/io/semantic_kitti_reader.h"
+#if SEMSEGMAP_WITH_SIM
 #include "semsegmap/sim/simulator.h"
+#endif
 
 namespace semsegmap {
 
 namespace {
 
+#if SEMSEGMAP_WITH_SIM
 uint64_t parseUnsigned(const std::string& spec, const std::string& key, const std::string& value) {
   size_t used = 0;
   unsigned long long v = 0;
@@ -60,6 +63,13 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
   config.world = sim::worldPreset(preset, world_seed);
   return std::make_unique<sim::Simulator>(config);
 }
+#else
+std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::string&) {
+  throw std::runtime_error("dataset '" + spec +
+                           "': this build has no simulator (built without Embree, reconfigure "
+                           "with -DSEMSEGMAP_WITH_SIM=ON)");
+}
+#endif
 
 }  // namespace
 

@@ -6,7 +6,8 @@
 //   sim:KEY=VALUE,...      the built-in simulator, streamed without touching the disk; keys:
 //                          world (seed, default 1), run (S0..S3, default S2), condition,
 //                          traffic (seed), frames (maximum), preset (full|small|tiny), cameras
-//                          (0|1)
+//                          (0|1); a build without the simulator (SEMSEGMAP_WITH_SIM=OFF)
+//                          says so in one line
 #pragma once
 
 #include <memory>

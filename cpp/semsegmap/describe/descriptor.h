@@ -18,6 +18,11 @@ enum class DescriptorKind { kEigen, kFpfh, kSegMapCnn, kSemSegMapNet };
 std::string descriptorName(DescriptorKind kind);
 DescriptorKind parseDescriptorKind(const std::string& name);
 
+// Why this build cannot describe with `kind`, in one line, or "" when it can: the learned kinds
+// need libtorch (the build option SEMSEGMAP_WITH_TORCH), fpfh needs PCL (SEMSEGMAP_WITH_PCL).
+// Every kind keeps its name either way, so that maps and model files of any build can be read.
+std::string descriptorNotBuilt(DescriptorKind kind);
+
 // What a descriptor sees of a segment observation: its points (map frame, with colour and
 // class) and its size in points (the triplet loss weighs pairs by the ratio of the two).
 struct DescriptorInput {
@@ -43,7 +48,8 @@ struct DescriberOptions {
   int threads = 0;                         // 0: all cores
 };
 
-// Throws std::invalid_argument for a learned kind without a network or with one of another kind.
+// Throws std::invalid_argument for a learned kind without a network or with one of another kind,
+// std::runtime_error "<kind>: <descriptorNotBuilt>" for a kind this build does not have.
 std::unique_ptr<Describer> makeDescriber(DescriptorKind kind, const DescriberOptions& options);
 
 }  // namespace semsegmap

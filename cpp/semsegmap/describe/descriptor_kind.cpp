@@ -30,4 +30,22 @@ DescriptorKind parseDescriptorKind(const std::string& name) {
                               "' (expected eigen, fpfh, segmap-cnn or semsegmap-net)");
 }
 
+std::string descriptorNotBuilt(DescriptorKind kind) {
+  switch (kind) {
+    case DescriptorKind::kEigen:
+      return "";
+    case DescriptorKind::kFpfh:
+      return SEMSEGMAP_WITH_PCL ? ""
+                                : "this build has no FPFH (built without PCL, reconfigure with "
+                                  "-DSEMSEGMAP_WITH_PCL=ON)";
+    case DescriptorKind::kSegMapCnn:
+    case DescriptorKind::kSemSegMapNet:
+      return SEMSEGMAP_WITH_TORCH ? ""
+                                  : "this build has no learned descriptors (built without "
+                                    "libtorch, reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)";
+  }
+  throw std::invalid_argument("descriptorNotBuilt: invalid DescriptorKind value " +
+                              std::to_string(static_cast<int>(kind)));
+}
+
 }  // namespace semsegmap

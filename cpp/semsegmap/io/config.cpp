@@ -42,7 +42,10 @@ void readSection(const std::filesystem::path& path, const YAML::Node& root, cons
 
 }  // namespace
 
-PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
+namespace {
+
+// The YAML document, whose top level may hold only the known sections.
+YAML::Node loadConfigRoot(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path))
     throw std::runtime_error(path.string() + ": no such config file");
   YAML::Node root;
@@ -62,6 +65,45 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
       throw std::runtime_error(path.string() + ": " + key + ": unknown section");
   }
 
+  return root;
+}
+
+void checkPipelineConfig(const std::filesystem::path& path, const PipelineConfig& c) {
+  const auto& lm = c.local_map;
+  const auto& sg = c.segmentation;
+  const auto& d = c.descriptor;
+  const auto& loc = c.localization;
+  const auto& lc = c.loop_closure;
+  auto check = [&](bool ok, const std::string& what) {
+    if (!ok) throw std::runtime_error(path.string() + ": " + what);
+  };
+  check(lm.voxel_size_m > 0, "local_map.voxel_size_m: must be positive");
+  check(lm.radius_m > lm.voxel_size_m, "local_map.radius_m: must exceed the voxel size");
+  check(lm.min_points_per_voxel >= 1, "local_map.min_points_per_voxel: must be at least 1");
+  check(sg.d_segment_m > 0, "segmentation.d_segment_m: must be positive");
+  check(sg.hue_threshold >= 0 && sg.hue_threshold <= 0.5,
+        "segmentation.hue_threshold: must be in [0, 0.5]");
+  check(sg.hue_penalty >= 0 && sg.class_penalty >= 0,
+        "segmentation: penalties must not be negative");
+  check(sg.min_segment_points <= sg.max_segment_points,
+        "segmentation.min_segment_points: must not exceed max_segment_points");
+  check(c.enrichment.occlusion_radius_px >= 0,
+        "enrichment.occlusion_radius_px: must not be negative");
+  check(d.batch >= 1, "descriptor.batch: must be at least 1");
+  check(loc.localizer.index.k >= 1, "localization.k: must be at least 1");
+  check(loc.localizer.verification.resolution_m > 0, "localization.resolution_m: must be positive");
+  check(loc.localizer.verification.min_inliers >= 3,
+        "localization.min_inliers: must be at least 3 (a rigid transform needs 3 points)");
+  check(loc.every_n_frames >= 1, "localization.every_n_frames: must be at least 1");
+  check(c.target_map.duplicate_distance_m >= 0,
+        "target_map.duplicate_distance_m: must not be negative");
+  check(lc.exclude_recent_m >= 0, "loop_closure.exclude_recent_m: must not be negative");
+}
+
+}  // namespace
+
+PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
+  const YAML::Node root = loadConfigRoot(path);
   PipelineConfig c;
   readSection(path, root, "enrichment",
               {{"occlusion_radius_px", set(c.enrichment.occlusion_radius_px)},
@@ -117,30 +159,7 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"loop_translation_sigma_m", set(lc.graph.loop_translation_sigma_m)},
                {"loop_rotation_sigma_rad", set(lc.graph.loop_rotation_sigma_rad)}});
 
-  auto check = [&](bool ok, const std::string& what) {
-    if (!ok) throw std::runtime_error(path.string() + ": " + what);
-  };
-  check(lm.voxel_size_m > 0, "local_map.voxel_size_m: must be positive");
-  check(lm.radius_m > lm.voxel_size_m, "local_map.radius_m: must exceed the voxel size");
-  check(lm.min_points_per_voxel >= 1, "local_map.min_points_per_voxel: must be at least 1");
-  check(sg.d_segment_m > 0, "segmentation.d_segment_m: must be positive");
-  check(sg.hue_threshold >= 0 && sg.hue_threshold <= 0.5,
-        "segmentation.hue_threshold: must be in [0, 0.5]");
-  check(sg.hue_penalty >= 0 && sg.class_penalty >= 0,
-        "segmentation: penalties must not be negative");
-  check(sg.min_segment_points <= sg.max_segment_points,
-        "segmentation.min_segment_points: must not exceed max_segment_points");
-  check(c.enrichment.occlusion_radius_px >= 0,
-        "enrichment.occlusion_radius_px: must not be negative");
-  check(d.batch >= 1, "descriptor.batch: must be at least 1");
-  check(loc.localizer.index.k >= 1, "localization.k: must be at least 1");
-  check(loc.localizer.verification.resolution_m > 0, "localization.resolution_m: must be positive");
-  check(loc.localizer.verification.min_inliers >= 3,
-        "localization.min_inliers: must be at least 3 (a rigid transform needs 3 points)");
-  check(loc.every_n_frames >= 1, "localization.every_n_frames: must be at least 1");
-  check(c.target_map.duplicate_distance_m >= 0,
-        "target_map.duplicate_distance_m: must not be negative");
-  check(lc.exclude_recent_m >= 0, "loop_closure.exclude_recent_m: must not be negative");
+  checkPipelineConfig(path, c);
   return c;
 }
 

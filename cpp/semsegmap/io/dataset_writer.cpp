@@ -103,36 +103,45 @@ DatasetWriter::DatasetWriter(const fs::path& dir, const DatasetInfo& info)
                       [](std::ostream& out) { out << kFramesCsvHeader << '\n'; });
 }
 
-void DatasetWriter::write(const Frame& frame) {
-  const size_t n_cameras = info_.rig.cameras.size();
-  const std::string name = frameFileName(frame.index, "bin");
-  const std::string png = frameFileName(frame.index, "png");
-  const fs::path csv = dir_ / "frames.csv";
-  auto reject = [&](const fs::path& file, const std::string& what) {
-    throw std::invalid_argument(file.string() + ": frame " + std::to_string(frame.index) + ": " +
-                                what);
-  };
+namespace {
 
-  // Everything is checked before the first file is written, so a rejected frame leaves no trace.
+[[noreturn]] void reject(const fs::path& file, const Frame& frame, const std::string& what) {
+  throw std::invalid_argument(file.string() + ": frame " + std::to_string(frame.index) + ": " +
+                              what);
+}
+
+}  // namespace
+
+void DatasetWriter::checkFrame(const Frame& frame) const {
+  const fs::path csv = dir_ / "frames.csv";
   if (last_index_ && frame.index <= *last_index_)
-    reject(csv, "index does not follow the previous frame's " + std::to_string(*last_index_) +
-                    "; indices must increase");
-  if (!std::isfinite(frame.timestamp_s)) reject(csv, "timestamp is not finite");
+    reject(csv, frame,
+           "index does not follow the previous frame's " + std::to_string(*last_index_) +
+               "; indices must increase");
+  if (!std::isfinite(frame.timestamp_s)) reject(csv, frame, "timestamp is not finite");
   if (frame.T_world_base && !info_.has_ground_truth_poses)
-    reject(csv, "has a ground-truth pose but DatasetInfo::has_ground_truth_poses is false");
-  const fs::path label_path = dir_ / "lidar_gt" / name;
+    reject(csv, frame, "has a ground-truth pose but DatasetInfo::has_ground_truth_poses is false");
+  const fs::path label_path = dir_ / "lidar_gt" / frameFileName(frame.index, "bin");
   if (info_.has_point_labels) {
     if (frame.point_labels.size() != frame.points.size())
-      reject(label_path, std::to_string(frame.point_labels.size()) + " point labels for " +
-                             std::to_string(frame.points.size()) + " points");
+      reject(label_path, frame,
+             std::to_string(frame.point_labels.size()) + " point labels for " +
+                 std::to_string(frame.points.size()) + " points");
     checkLabelClasses(label_path, frame.point_labels, info_.classes);
   } else if (!frame.point_labels.empty()) {
-    reject(label_path, "has point labels but DatasetInfo::has_point_labels is false");
+    reject(label_path, frame, "has point labels but DatasetInfo::has_point_labels is false");
   }
+  const size_t n_cameras = info_.rig.cameras.size();
   if (!frame.cameras.empty() && frame.cameras.size() != n_cameras)
-    reject(csv, "has " + std::to_string(frame.cameras.size()) + " camera images but meta.yaml " +
-                    "lists " + std::to_string(n_cameras) + " cameras");
+    reject(csv, frame,
+           "has " + std::to_string(frame.cameras.size()) + " camera images but meta.yaml " +
+               "lists " + std::to_string(n_cameras) + " cameras");
+}
 
+std::pair<std::vector<bool>, std::vector<bool>> DatasetWriter::checkCameras(
+    const Frame& frame) const {
+  const size_t n_cameras = info_.rig.cameras.size();
+  const std::string png = frameFileName(frame.index, "png");
   std::vector<bool> has_rgb(n_cameras, false), has_label(n_cameras, false);
   for (size_t k = 0; k < frame.cameras.size(); ++k) {
     has_rgb[k] = !frame.cameras[k].rgb.empty();
@@ -144,23 +153,28 @@ void DatasetWriter::write(const Frame& frame) {
     const fs::path rgb_path = cameraDir(dir_, k, false) / png;
     const fs::path label_png = cameraDir(dir_, k, true) / png;
     if (!first && has_rgb[k] != camera_has_rgb_[k])
-      reject(rgb_path, std::string(has_rgb[k] ? "has" : "lacks") + " an rgb image of camera '" +
-                           cam.name + "', unlike the first frame written");
+      reject(rgb_path, frame,
+             std::string(has_rgb[k] ? "has" : "lacks") + " an rgb image of camera '" + cam.name +
+                 "', unlike the first frame written");
     if (!first && has_label[k] != camera_has_label_[k])
-      reject(label_png, std::string(has_label[k] ? "has" : "lacks") + " a label image of camera '" +
-                            cam.name + "', unlike the first frame written");
+      reject(label_png, frame,
+             std::string(has_label[k] ? "has" : "lacks") + " a label image of camera '" + cam.name +
+                 "', unlike the first frame written");
     if (has_rgb[k]) checkImage(rgb_path, frame.cameras[k].rgb, cam, "rgb", 3);
     if (has_label[k]) {
       checkImage(label_png, frame.cameras[k].label, cam, "label", 1);
       checkLabelClasses(label_png, frame.cameras[k].label, info_.classes);
     }
   }
-  std::string row = std::to_string(frame.index) + "," + formatExactDouble(frame.timestamp_s) +
-                    csvPose(csv, frame.index, "odometry", frame.T_odom_base);
-  row += frame.T_world_base ? csvPose(csv, frame.index, "ground-truth", *frame.T_world_base)
-                            : std::string(",,,,,,,");
+  return {has_rgb, has_label};
+}
 
-  if (first) {
+void DatasetWriter::writeFiles(const Frame& frame, const std::vector<bool>& has_rgb,
+                               const std::vector<bool>& has_label) {
+  const size_t n_cameras = info_.rig.cameras.size();
+  const std::string name = frameFileName(frame.index, "bin");
+  const std::string png = frameFileName(frame.index, "png");
+  if (!last_index_) {
     for (size_t k = 0; k < n_cameras; ++k) {
       if (has_rgb[k]) fs::create_directories(cameraDir(dir_, k, false));
       if (has_label[k]) fs::create_directories(cameraDir(dir_, k, true));
@@ -169,11 +183,23 @@ void DatasetWriter::write(const Frame& frame) {
     camera_has_label_ = has_label;
   }
   writeLidarBin(dir_ / "lidar" / name, frame.points);
-  if (info_.has_point_labels) writeLabelBin(label_path, frame.point_labels);
+  if (info_.has_point_labels) writeLabelBin(dir_ / "lidar_gt" / name, frame.point_labels);
   for (size_t k = 0; k < n_cameras; ++k) {
     if (has_rgb[k]) writePng(cameraDir(dir_, k, false) / png, frame.cameras[k].rgb);
     if (has_label[k]) writePng(cameraDir(dir_, k, true) / png, frame.cameras[k].label);
   }
+}
+
+void DatasetWriter::write(const Frame& frame) {
+  const fs::path csv = dir_ / "frames.csv";
+  // Everything is checked before the first file is written, so a rejected frame leaves no trace.
+  checkFrame(frame);
+  const auto [has_rgb, has_label] = checkCameras(frame);
+  std::string row = std::to_string(frame.index) + "," + formatExactDouble(frame.timestamp_s) +
+                    csvPose(csv, frame.index, "odometry", frame.T_odom_base);
+  row += frame.T_world_base ? csvPose(csv, frame.index, "ground-truth", *frame.T_world_base)
+                            : std::string(",,,,,,,");
+  writeFiles(frame, has_rgb, has_label);
 
   // The row goes last: a frame is part of the dataset only once all its files are in place.
   std::ofstream out(csv, std::ios::binary | std::ios::app);

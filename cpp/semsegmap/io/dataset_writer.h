@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "semsegmap/core/frame_source.h"
@@ -21,6 +22,13 @@ class DatasetWriter {
   size_t framesWritten() const { return frames_written_; }
 
  private:
+  // The checks of write(), all before the first file is written.
+  void checkFrame(const Frame& frame) const;
+  // Which cameras have an rgb and a label image, checked against the first frame's.
+  std::pair<std::vector<bool>, std::vector<bool>> checkCameras(const Frame& frame) const;
+  void writeFiles(const Frame& frame, const std::vector<bool>& has_rgb,
+                  const std::vector<bool>& has_label);
+
   std::filesystem::path dir_;
   DatasetInfo info_;
   size_t frames_written_ = 0;

@@ -1,5 +1,7 @@
 #include "semsegmap/io/kitti_calib.h"
 
+#include "semsegmap/io/dataset_format.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -204,6 +206,28 @@ LidarModel velodyneHdl64e() {
   m.range_noise_m = 0.02;
   m.dropout = 0.0;  // real scans already carry their dropouts
   return m;
+}
+
+double kittiScanTime(const std::vector<double>* times, const std::filesystem::path& times_path,
+                     size_t number, double rate_hz) {
+  if (!times) return static_cast<double>(number) / rate_hz;
+  if (number >= times->size())
+    throw std::runtime_error(times_path.string() + ": no line for frame " + std::to_string(number) +
+                             " (" + std::to_string(times->size()) + " lines)");
+  return (*times)[number];
+}
+
+Frame kittiScanFrame(size_t index, double timestamp_s, const std::filesystem::path& path) {
+  Frame f;
+  f.index = index;
+  f.timestamp_s = timestamp_s;
+  f.points = readLidarBin(path);  // rejects truncation and NaN/inf, naming the point
+  return f;
+}
+
+void throwFrameOutOfRange(const std::string& dataset, size_t index, size_t frames) {
+  throw std::out_of_range(dataset + ": frame " + std::to_string(index) + " out of range (" +
+                          std::to_string(frames) + " frames)");
 }
 
 }  // namespace semsegmap

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "semsegmap/core/frame.h"
 #include "semsegmap/core/pose.h"
 #include "semsegmap/core/sensor_rig.h"
 
@@ -64,6 +65,16 @@ Eigen::Matrix3d nearestRotation(const Eigen::Matrix3d& M);
 // whose name is not a number.
 std::vector<std::pair<size_t, std::filesystem::path>> listKittiFrames(
     const std::filesystem::path& dir, const std::string& extension);
+
+// The time of scan `number`: its line of `times` when the dataset has a times file (read from
+// `times_path`; throws naming it when it has no line for the scan), else number / rate_hz.
+double kittiScanTime(const std::vector<double>* times, const std::filesystem::path& times_path,
+                     size_t number, double rate_hz);
+
+// A frame of scan `path` (KITTI's .bin, read with readLidarBin) and nothing else yet.
+Frame kittiScanFrame(size_t index, double timestamp_s, const std::filesystem::path& path);
+// std::out_of_range "<dataset>: frame <index> out of range (<frames> frames)".
+[[noreturn]] void throwFrameOutOfRange(const std::string& dataset, size_t index, size_t frames);
 
 // KITTI raw's rectified camera `index` (2 = left color) as our PinholeCamera, such that
 // camera.project(camera.T_camera_lidar * X) equals the devkit's

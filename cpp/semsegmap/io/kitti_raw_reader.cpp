@@ -138,15 +138,8 @@ KittiRawReader::KittiRawReader(const fs::path& drive_dir) : dir_(normalizedDir(d
         throw std::runtime_error(f.oxts.string() + ": missing (the oxts record of scan " +
                                  scan.string() + ")");
     }
-    if (has_times) {
-      if (number >= times.size())
-        throw std::runtime_error(times_path.string() + ": no line for frame " +
-                                 std::to_string(number) + " (" + std::to_string(times.size()) +
-                                 " lines)");
-      f.timestamp_s = times[number];
-    } else {
-      f.timestamp_s = static_cast<double>(number) / info_.rig.rate_hz;
-    }
+    f.timestamp_s =
+        kittiScanTime(has_times ? &times : nullptr, times_path, number, info_.rig.rate_hz);
     frames_.push_back(f);
   }
 
@@ -179,14 +172,9 @@ Pose KittiRawReader::oxtsPose(const fs::path& oxts_file) const {
 }
 
 Frame KittiRawReader::frame(size_t index) {
-  if (index >= frames_.size())
-    throw std::out_of_range(info_.name + ": frame " + std::to_string(index) + " out of range (" +
-                            std::to_string(frames_.size()) + " frames)");
+  if (index >= frames_.size()) throwFrameOutOfRange(info_.name, index, frames_.size());
   const FrameFiles& files = frames_[index];
-  Frame f;
-  f.index = index;
-  f.timestamp_s = files.timestamp_s;
-  f.points = readLidarBin(files.scan);  // rejects truncation and NaN/inf, naming the point
+  Frame f = kittiScanFrame(index, files.timestamp_s, files.scan);
 
   Image rgb = readPng(files.image);
   const PinholeCamera& cam = info_.rig.cameras.front();

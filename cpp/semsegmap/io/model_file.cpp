@@ -5,7 +5,9 @@
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/binary_io.h"
+#if SEMSEGMAP_WITH_TORCH
 #include "semsegmap/describe/learned_net.h"
+#endif
 
 namespace semsegmap {
 
@@ -114,6 +116,7 @@ Model readModelFile(const std::filesystem::path& path, std::optional<DescriptorK
   return model;
 }
 
+#if SEMSEGMAP_WITH_TORCH
 void saveNet(const std::filesystem::path& path, DescriptorNetImpl& net) {
   writeModelFile(path, modelOf(net));
 }
@@ -127,17 +130,28 @@ std::shared_ptr<DescriptorNetImpl> loadNet(const std::filesystem::path& path,
     throw std::runtime_error(path.string() + ": " + e.what());
   }
 }
+#endif
+
+void requireDescriberBuilt(const DescriptorConfig& config, const std::string& where) {
+  const std::string missing = descriptorNotBuilt(parseDescriptorKind(config.kind));
+  if (!missing.empty())
+    throw std::runtime_error((where.empty() ? "" : where + ": ") + "descriptor.kind " +
+                             config.kind + ": " + missing);
+}
 
 std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int threads) {
+  requireDescriberBuilt(config);
   const DescriptorKind kind = parseDescriptorKind(config.kind);
   DescriberOptions options;
   options.threads = threads;
+#if SEMSEGMAP_WITH_TORCH
   if (kind == DescriptorKind::kSemSegMapNet || kind == DescriptorKind::kSegMapCnn) {
     if (config.model.empty())
       throw std::invalid_argument("descriptor.kind " + config.kind +
                                   " needs a model file (descriptor.model)");
     options.net = loadNet(config.model, kind);
   }
+#endif
   return makeDescriber(kind, options);
 }
 

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/describe/net_config.h"
@@ -31,13 +32,20 @@ void writeModelFile(const std::filesystem::path& path, const Model& model);
 Model readModelFile(const std::filesystem::path& path,
                     std::optional<DescriptorKind> expected = std::nullopt);
 
-// The network of a model file, and back.
+#if SEMSEGMAP_WITH_TORCH
+// The network of a model file, and back (only in a build with libtorch).
 void saveNet(const std::filesystem::path& path, DescriptorNetImpl& net);
 std::shared_ptr<DescriptorNetImpl> loadNet(const std::filesystem::path& path,
                                            std::optional<DescriptorKind> expected = std::nullopt);
+#endif
 
 // The describer a configuration asks for (descriptor.kind, and descriptor.model for the learned
-// kinds); `threads` 0: all cores.
+// kinds); `threads` 0: all cores. Checks requireDescriberBuilt first.
 std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int threads = 0);
+
+// Throws std::runtime_error "[where: ]descriptor.kind K: this build has no ... (built without
+// ..., reconfigure with -D...=ON)" when this build lacks the describer of `config`
+// (descriptorNotBuilt), without loading anything: for commands to fail before they start.
+void requireDescriberBuilt(const DescriptorConfig& config, const std::string& where = "");
 
 }  // namespace semsegmap

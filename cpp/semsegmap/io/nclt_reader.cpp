@@ -1,5 +1,7 @@
 #include "semsegmap/io/nclt_reader.h"
 
+#include "semsegmap/io/kitti_calib.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -185,9 +187,7 @@ NcltReader::NcltReader(const fs::path& session_dir)
 }
 
 Frame NcltReader::frame(size_t index) {
-  if (index >= frames_.size())
-    throw std::out_of_range(info_.name + ": frame " + std::to_string(index) + " out of range (" +
-                            std::to_string(frames_.size()) + " frames)");
+  if (index >= frames_.size()) throwFrameOutOfRange(info_.name, index, frames_.size());
   const FrameFiles& files = frames_[index];
   std::ifstream in(files.scan, std::ios::binary);
   if (!in) throw std::runtime_error(files.scan.string() + ": cannot open");

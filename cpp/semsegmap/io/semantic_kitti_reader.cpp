@@ -140,15 +140,8 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
         throw std::runtime_error(f.labels.string() + ": missing (the labels of scan " +
                                  scan.string() + ")");
     }
-    if (has_times) {
-      if (number >= times.size())
-        throw std::runtime_error(times_path.string() + ": no time for frame " +
-                                 std::to_string(number) + " (" + std::to_string(times.size()) +
-                                 " lines)");
-      f.timestamp_s = times[number];
-    } else {
-      f.timestamp_s = static_cast<double>(number) * 0.1;  // the Velodyne's 10 Hz
-    }
+    f.timestamp_s = kittiScanTime(has_times ? &times : nullptr, times_path, number,
+                                  10.0);  // without times.txt, the Velodyne's 10 Hz
     if (has_poses) {
       if (number >= poses.size())
         throw std::runtime_error(poses_path.string() + ": no pose for frame " +
@@ -169,14 +162,9 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
 }
 
 Frame SemanticKittiReader::frame(size_t index) {
-  if (index >= frames_.size())
-    throw std::out_of_range(info_.name + ": frame " + std::to_string(index) + " out of range (" +
-                            std::to_string(frames_.size()) + " frames)");
+  if (index >= frames_.size()) throwFrameOutOfRange(info_.name, index, frames_.size());
   const FrameFiles& files = frames_[index];
-  Frame f;
-  f.index = index;
-  f.timestamp_s = files.timestamp_s;
-  f.points = readLidarBin(files.scan);  // rejects truncation and NaN/inf, naming the point
+  Frame f = kittiScanFrame(index, files.timestamp_s, files.scan);
   if (!files.labels.empty()) {
     f.point_labels = readLabelBin(files.labels);
     if (f.point_labels.size() != f.points.size())

@@ -90,8 +90,7 @@ void appendObservations(FrameSource& source, uint16_t source_index, PipelineConf
                              "' has no point instances (training needs simulated ground truth)");
   pipeline.segmentation.keep_all_observation_points = true;
   Pipeline pipe(pipeline, info, PoseSource::kGroundTruth);
-  const size_t n =
-      config.max_frames > 0 ? std::min(source.size(), config.max_frames) : source.size();
+  const size_t n = framesToRead(source, config.max_frames);
   for (size_t i = 0; i < n; ++i) {
     FrameResult r = pipe.process(source.frame(i));
     for (const Segment& s : r.segmentation.finished)
@@ -108,7 +107,7 @@ std::vector<uint64_t> objectKeys(const TrainingSet& set) {
   std::vector<uint64_t> world(set.sources.size());
   for (size_t s = 0; s < world.size(); ++s) {
     const std::string& name = s < set.source_worlds.size() ? set.source_worlds[s] : set.sources[s];
-    world[s] = fnv1a64(name.data(), name.size());
+    world[s] = fnv1a64(name.data(), name.size(), kProjectFnvSeed);
   }
   std::vector<uint64_t> keys;
   keys.reserve(set.observations.size());

@@ -17,9 +17,7 @@ struct RunOptions {
   size_t max_frames = 0;                                    // 0: all
   std::function<void(size_t done, size_t total)> progress;  // optional
   // The frames a run reads of `source`: the first max_frames, or all.
-  size_t frameCount(const FrameSource& source) const {
-    return max_frames > 0 ? std::min(source.size(), max_frames) : source.size();
-  }
+  size_t frameCount(const FrameSource& source) const { return framesToRead(source, max_frames); }
 };
 
 struct RunStats {

@@ -41,6 +41,14 @@ class WorldContext {
   std::vector<Circle> occupied_;
 };
 
+// A street (an edge of the road network) as a frame: from node a to node b, its direction and
+// the direction to its left.
+struct EdgeFrame {
+  Eigen::Vector2d a, b, dir, left;
+  double length;
+};
+EdgeFrame edgeFrame(const RoadNetwork& roads, const std::pair<int, int>& e);
+
 // Stage generators, called in this order by generateWorld.
 void buildStreets(WorldContext& ctx);          // ground, roads, sidewalks
 void buildLots(WorldContext& ctx);             // houses, yards, lot vegetation, fences

@@ -228,10 +228,7 @@ void buildLots(WorldContext& ctx) {
   const RoadNetwork& roads = ctx.world.roads;
   const double curb = 0.5 * roads.road_width_m + roads.sidewalk_width_m;
   for (const auto& e : roads.edges) {
-    const Eigen::Vector2d a = roads.nodes[e.first], b = roads.nodes[e.second];
-    const double length = (b - a).norm();
-    const Eigen::Vector2d dir = (b - a) / length;
-    const Eigen::Vector2d left(-dir.y(), dir.x());
+    const auto [a, b, dir, left, length] = edgeFrame(roads, e);
     for (int side : {-1, 1}) {
       double s = curb + 10.0 + ctx.rng.uniform(0.0, 4.0);
       while (true) {

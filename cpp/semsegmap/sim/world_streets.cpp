@@ -6,13 +6,6 @@
 
 namespace semsegmap::sim::detail {
 
-namespace {
-
-struct EdgeFrame {
-  Eigen::Vector2d a, b, dir, left;
-  double length;
-};
-
 EdgeFrame edgeFrame(const RoadNetwork& roads, const std::pair<int, int>& e) {
   EdgeFrame f;
   f.a = roads.nodes[e.first];
@@ -22,8 +15,6 @@ EdgeFrame edgeFrame(const RoadNetwork& roads, const std::pair<int, int>& e) {
   f.left = {-f.dir.y(), f.dir.x()};
   return f;
 }
-
-}  // namespace
 
 void buildStreets(WorldContext& ctx) {
   World& w = ctx.world;

@@ -40,10 +40,7 @@ void buildTraffic(WorldContext& ctx) {
 
   // Parked cars: slots along both curbs, away from the intersections.
   for (const auto& e : roads.edges) {
-    const Eigen::Vector2d a = roads.nodes[e.first], b = roads.nodes[e.second];
-    const double length = (b - a).norm();
-    const Eigen::Vector2d dir = (b - a) / length;
-    const Eigen::Vector2d left(-dir.y(), dir.x());
+    const auto [a, b, dir, left, length] = edgeFrame(roads, e);
     for (int side : {-1, 1}) {
       for (double s = 14.0; s < length - 14.0; s += 7.0) {
         if (!ctx.rng.chance(w.config.parked_car_probability)) continue;

@@ -125,8 +125,8 @@ void runGnuplot(const std::filesystem::path& png, const std::filesystem::path& d
                 const std::string& script_text) {
   const std::filesystem::path script = dir / "plot.gp";
   writeBytesAtomically(script, script_text);
-  const std::string command =
-      "gnuplot " + quoted(script.string()) + " 2>" + quoted((dir / "gnuplot.log").string());
+  const std::string command = quoted(SEMSEGMAP_GNUPLOT) + " " + quoted(script.string()) + " 2>" +
+                              quoted((dir / "gnuplot.log").string());
   const int status = std::system(command.c_str());
   if (status != 0 || !std::filesystem::exists(png.string() + ".tmp"))
     throw std::runtime_error(png.string() + ": gnuplot failed (is gnuplot installed? see " +
