@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <set>
 #include <string>
 
@@ -55,8 +54,20 @@ struct Violation {
   std::string file, include;
 };
 
+// The folder of a `#include "semsegmap/<folder>/..."` line, or "" for any other line. Parsed by
+// hand: GCC 12 warns inside <regex> under the sanitizers, and warnings are errors.
+std::string includedFolder(const std::string& line) {
+  const size_t hash = line.find_first_not_of(" \t");
+  if (hash == std::string::npos || line[hash] != '#' ||
+      line.find("include", hash) == std::string::npos)
+    return "";
+  const size_t at = line.find("semsegmap/", hash);
+  if (at == std::string::npos || at == 0 || (line[at - 1] != '"' && line[at - 1] != '<')) return "";
+  const size_t start = at + 10, end = line.find('/', start);
+  return end == std::string::npos ? "" : line.substr(start, end - start);
+}
+
 std::vector<Violation> violations(const fs::path& root) {
-  const std::regex include_re(R"(^\s*#\s*include\s*[<"]semsegmap/([a-z_]+)/)");
   std::vector<Violation> out;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {
     const fs::path& p = entry.path();
@@ -69,10 +80,11 @@ std::vector<Violation> violations(const fs::path& root) {
     }
     std::ifstream in(p);
     std::string line;
-    std::smatch m;
-    while (std::getline(in, line))
-      if (std::regex_search(line, m, include_re) && m[1] != folder && !rule->second.count(m[1]))
+    while (std::getline(in, line)) {
+      const std::string included = includedFolder(line);
+      if (!included.empty() && included != folder && !rule->second.count(included))
         out.push_back({p.string(), line});
+    }
   }
   return out;
 }
@@ -98,7 +110,8 @@ TEST(Layers, AStageIncludingIoIsCaught) {
   fs::remove_all(root);
   fs::create_directories(root / "segment");
   std::ofstream(root / "segment" / "bad.cpp") << "#include \"semsegmap/io/map_file.h\"\n";
-  std::ofstream(root / "segment" / "good.cpp") << "#include \"semsegmap/core/pose.h\"\n";
+  std::ofstream(root / "segment" / "good.cpp") << "#include \"semsegmap/core/pose.h\"\n"
+                                               << "// #include \"semsegmap/io/x.h\" in a comment\n";
   const auto found = violations(root);
   ASSERT_EQ(found.size(), 1u);
   EXPECT_NE(found[0].file.find("bad.cpp"), std::string::npos);
