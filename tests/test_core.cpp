@@ -109,7 +109,7 @@ TEST(SensorRig, DefaultRigLooksLeftFrontRight) {
 }
 
 TEST(SensorRig, PixelRayInvertsProjection) {
-  const PinholeCamera cam = defaultSimRig().cameras[1];
+  const Camera cam = defaultSimRig().cameras[1];
   const Eigen::Vector3d ray = cam.pixelRay(100.5, 400.25);
   const auto uv = cam.project(ray * 7.0);
   ASSERT_TRUE(uv.has_value());

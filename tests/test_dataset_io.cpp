@@ -75,6 +75,7 @@ DatasetInfo tinyInfo() {
   DatasetInfo info;
   info.name = "tiny test";
   info.has_ground_truth_poses = true;
+  info.has_odometry = true;
   info.has_point_labels = true;
   info.rig.rate_hz = 10.0 / 3.0;  // not representable in a few digits: tests full precision
   info.rig.lidar.columns = 32;
@@ -89,7 +90,7 @@ DatasetInfo tinyInfo() {
   info.rig.T_base_lidar = somePose(0.2, 0.4, 0.7);
   const char* names[] = {"left", "front"};
   for (int k = 0; k < 2; ++k) {
-    PinholeCamera cam;
+    Camera cam;
     cam.name = names[k];
     cam.width = 8;
     cam.height = 6;
@@ -162,6 +163,7 @@ void expectSameFrame(const Frame& a, const Frame& b) {
 void expectSameInfo(const DatasetInfo& a, const DatasetInfo& b) {
   EXPECT_EQ(a.name, b.name);
   EXPECT_EQ(a.has_ground_truth_poses, b.has_ground_truth_poses);
+  EXPECT_EQ(a.has_odometry, b.has_odometry);
   EXPECT_EQ(a.has_point_labels, b.has_point_labels);
   EXPECT_TRUE(a.classes == b.classes);
   EXPECT_EQ(a.rig.rate_hz, b.rig.rate_hz);
@@ -178,7 +180,7 @@ void expectSameInfo(const DatasetInfo& a, const DatasetInfo& b) {
   EXPECT_LT(poseDifference(a.rig.T_base_lidar, b.rig.T_base_lidar), 1e-12);
   ASSERT_EQ(a.rig.cameras.size(), b.rig.cameras.size());
   for (size_t k = 0; k < a.rig.cameras.size(); ++k) {
-    const PinholeCamera &ca = a.rig.cameras[k], &cb = b.rig.cameras[k];
+    const Camera &ca = a.rig.cameras[k], &cb = b.rig.cameras[k];
     EXPECT_EQ(ca.name, cb.name);
     EXPECT_EQ(ca.width, cb.width);
     EXPECT_EQ(ca.height, cb.height);

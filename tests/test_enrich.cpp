@@ -31,9 +31,9 @@ namespace {
 
 // A 40 x 30 camera with a 90-degree horizontal field of view, looking along the LiDAR's
 // direction `yaw_deg` (LiDAR x forward, y left, z up; camera x right, y down, z forward).
-PinholeCamera makeCamera(const std::string& name, double yaw_deg = 0.0,
+Camera makeCamera(const std::string& name, double yaw_deg = 0.0,
                          const Eigen::Vector3d& offset_in_lidar = Eigen::Vector3d::Zero()) {
-  PinholeCamera cam;
+  Camera cam;
   cam.name = name;
   cam.width = 40;
   cam.height = 30;
@@ -52,7 +52,7 @@ PinholeCamera makeCamera(const std::string& name, double yaw_deg = 0.0,
 
 // Every pixel a different colour and a label that changes from pixel to pixel, so that a point
 // landing one pixel off would get visibly different values.
-CameraFrame patternImages(const PinholeCamera& cam) {
+CameraFrame patternImages(const Camera& cam) {
   CameraFrame cf{Image(cam.width, cam.height, 3), Image(cam.width, cam.height, 1)};
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
@@ -65,7 +65,7 @@ CameraFrame patternImages(const PinholeCamera& cam) {
   return cf;
 }
 
-CameraFrame uniformImages(const PinholeCamera& cam, uint8_t r, uint8_t g, uint8_t b,
+CameraFrame uniformImages(const Camera& cam, uint8_t r, uint8_t g, uint8_t b,
                           ClassId label) {
   CameraFrame cf{Image(cam.width, cam.height, 3), Image(cam.width, cam.height, 1)};
   for (int y = 0; y < cam.height; ++y)
@@ -80,7 +80,7 @@ CameraFrame uniformImages(const PinholeCamera& cam, uint8_t r, uint8_t g, uint8_
 }
 
 // The LiDAR point that `cam` sees at continuous pixel (u, v), `depth` metres in front of it.
-LidarPoint pointAtPixel(const PinholeCamera& cam, double u, double v, double depth) {
+LidarPoint pointAtPixel(const Camera& cam, double u, double v, double depth) {
   const Eigen::Vector3d p_cam((u - cam.cx) / cam.fx * depth, (v - cam.cy) / cam.fy * depth, depth);
   const Eigen::Vector3d p = cam.T_camera_lidar.inverse() * p_cam;
   return LidarPoint{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()),
@@ -248,7 +248,7 @@ TEST(Enrich, PointSeenByTwoCamerasTakesTheNearerImageCentre) {
   // Both cameras really do see the first two points (90-degree fields of view 50 degrees apart).
   for (int c = 0; c < 2; ++c)
     for (int i = 0; i < 2; ++i) {
-      const PinholeCamera& cam = rig.cameras[c];
+      const Camera& cam = rig.cameras[c];
       const auto uv = cam.project(cam.T_camera_lidar *
                                   Eigen::Vector3d(f.points[i].x, f.points[i].y, f.points[i].z));
       ASSERT_TRUE(uv && cam.inImage(*uv)) << cam.name << " point " << i;
@@ -264,7 +264,7 @@ TEST(Enrich, ZBufferRejectsAFarPointBehindANearOne) {
   // that the near ones hide from the camera.
   SensorRig rig;
   rig.cameras = {makeCamera("cam", 0.0, Eigen::Vector3d(0.0, 1.0, 0.0))};
-  const PinholeCamera& cam = rig.cameras[0];
+  const Camera& cam = rig.cameras[0];
   Frame f;
   f.cameras = {patternImages(cam)};
   f.points = {
@@ -315,7 +315,7 @@ TEST(Enrich, SurfaceAtAGrazingAngleDoesNotHideItself) {
   const EnrichedCloud cloud = enrichFrame(f, rig, EnrichmentConfig{});
   size_t in_image = 0, coloured = 0;
   for (size_t i = 0; i < cloud.size(); ++i) {
-    const PinholeCamera& cam = rig.cameras[0];
+    const Camera& cam = rig.cameras[0];
     const auto uv = cam.project(cam.T_camera_lidar *
                                 Eigen::Vector3d(f.points[i].x, f.points[i].y, f.points[i].z));
     if (!uv || !cam.inImage(*uv)) continue;
@@ -580,7 +580,7 @@ TEST(EnrichKitti, ColoursMatchTheDevkitProjection) {
     const size_t i = clear_in_image[k * clear_in_image.size() / 20];
     const LidarPoint& p = frame.points[i];
     const Eigen::Vector3d x = M * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
-    // Pixel x covers [x, x + 1) (PinholeCamera::inImage's convention), so the pixel is the floor.
+    // Pixel x covers [x, x + 1) (Camera::inImage's convention), so the pixel is the floor.
     const int px = static_cast<int>(std::floor(x.x() / x.z()));
     const int py = static_cast<int>(std::floor(x.y() / x.z()));
     SCOPED_TRACE("point " + std::to_string(i) + " at pixel " + std::to_string(px) + ", " +

@@ -134,7 +134,7 @@ TEST_F(KittiRaw, RealSampleLoads) {
   EXPECT_TRUE(info.classes == ClassTable::Default());
   EXPECT_TRUE(info.rig.T_base_lidar.isApprox(Pose::Identity()));
   ASSERT_EQ(info.rig.cameras.size(), 1u);
-  const PinholeCamera& cam = info.rig.cameras[0];
+  const Camera& cam = info.rig.cameras[0];
   EXPECT_EQ(cam.width, 1242);
   EXPECT_EQ(cam.height, 375);
   // P_rect_02 in calib_cam_to_cam.txt.
@@ -186,7 +186,7 @@ TEST_F(KittiRaw, ProjectionMatchesTheDevkitFormula) {
   };
 
   KittiRawReader reader(kDrive);
-  const PinholeCamera& cam = reader.info().rig.cameras.at(0);
+  const Camera& cam = reader.info().rig.cameras.at(0);
   const Frame f = reader.frame(3);
   int checked = 0, in_image = 0;
   for (size_t i = 0; i < f.points.size(); i += 101) {

@@ -106,7 +106,7 @@ TEST(LidarSim, SameSeedSameScanWhateverTheThreads) {
 TEST(CameraSim, LabelsDepthAndColourOfAWall) {
   const World w = wallWorld();
   RayScene scene(w);
-  const PinholeCamera cam = defaultSimRig().cameras[1];  // looks along +x
+  const Camera cam = defaultSimRig().cameras[1];  // looks along +x
   const Pose T_world_camera = cam.T_camera_lidar.inverse();
   const CameraRender r = renderCamera(scene, cam, T_world_camera, lightingFor("sunny"), 1, true);
   EXPECT_EQ(*r.label.at(320, 240), cls::kBuilding);
@@ -128,7 +128,7 @@ TEST(CameraSim, ShadowsDarkenWhatTheSunCannotSee) {
   // A wall facing away from the sun is lit by ambient light only, so it is darker.
   const World w = wallWorld({0.6f, 0.6f, 0.6f});
   RayScene scene(w);
-  const PinholeCamera cam = defaultSimRig().cameras[1];
+  const Camera cam = defaultSimRig().cameras[1];
   Lighting toward = lightingFor("sunny");
   toward.to_sun = Eigen::Vector3f(-1, 0, 1).normalized();  // sun behind the camera: wall lit
   Lighting away = toward;

@@ -36,7 +36,10 @@ struct Frame {
   double timestamp_s = 0.0;
   std::vector<LidarPoint> points;
   std::vector<PointLabel> point_labels;  // empty, or one per point
-  std::vector<CameraFrame> cameras;      // in the order of SensorRig::cameras
+  // When each point was measured, in seconds after timestamp_s (a spinning LiDAR sweeps while
+  // the robot moves); empty when the input has no per-point times.
+  std::vector<float> point_times;
+  std::vector<CameraFrame> cameras;  // in the order of SensorRig::cameras
   // Poses are named T_to_from, so that subscripts cancel: T_world_lidar = T_world_base *
   // rig.T_base_lidar. The odometry frame is where the robot's own odometry started; the world
   // frame is the dataset's ground truth, when it has one.

@@ -15,6 +15,10 @@ struct DatasetInfo {
   SensorRig rig;
   ClassTable classes = ClassTable::Default();
   bool has_ground_truth_poses = false;
+  // Whether Frame::T_odom_base comes from the data (wheel or visual odometry, a pose file, the
+  // simulator's drifting odometry). Without it T_odom_base is meaningless, and running on it
+  // is refused instead of reading identity poses.
+  bool has_odometry = false;
   bool has_point_labels = false;
   // Point instance ids from here on are traffic (parked and moving cars): no landmarks, and
   // another run of the same place has other ones. 0: the dataset has no such range.

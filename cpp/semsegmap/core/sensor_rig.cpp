@@ -15,14 +15,131 @@ Eigen::Vector3d LidarModel::beamDirection(int row, int col) const {
           std::sin(elevation)};
 }
 
-std::optional<Eigen::Vector2d> PinholeCamera::project(const Eigen::Vector3d& p) const {
-  if (p.z() <= 1e-6) return std::nullopt;
-  return Eigen::Vector2d(fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy);
+CameraModel parseCameraModel(const std::string& name) {
+  if (name == "pinhole") return CameraModel::kPinhole;
+  if (name == "radtan") return CameraModel::kRadialTangential;
+  if (name == "equidistant") return CameraModel::kEquidistant;
+  throw std::invalid_argument("unknown camera model '" + name +
+                              "' (expected pinhole, radtan or equidistant)");
 }
 
-Eigen::Vector3d PinholeCamera::pixelRay(double u, double v) const {
-  return Eigen::Vector3d((u - cx) / fx, (v - cy) / fy, 1.0).normalized();
+const char* cameraModelName(CameraModel model) {
+  switch (model) {
+    case CameraModel::kRadialTangential:
+      return "radtan";
+    case CameraModel::kEquidistant:
+      return "equidistant";
+    default:
+      return "pinhole";
+  }
 }
+
+// The lens models are written here rather than called from OpenCV because core/ depends on
+// the standard library and Eigen only, and enrichment projects every point into every camera
+// (a per-point cv::projectPoints call costs more than the arithmetic). The tests compare them
+// with OpenCV's cv::projectPoints and cv::fisheye::projectPoints.
+namespace {
+
+// d/dr of r * (1 + k1 r^2 + k2 r^4 + k3 r^6) as a polynomial in s = r^2.
+double radialSlope(const std::array<double, 5>& k, double s) {
+  return 1.0 + s * (3.0 * k[0] + s * (5.0 * k[1] + s * 7.0 * k[4]));
+}
+
+// The radial-tangential model is one-to-one from the axis out to radius sqrt(s) when the
+// slope stays positive on [0, s]: at s and at the slope's own turning points inside it.
+bool radialOneToOne(const std::array<double, 5>& k, double s) {
+  if (radialSlope(k, s) <= 0.0) return false;
+  // Turning points: 3 k1 + 10 k2 t + 21 k3 t^2 = 0.
+  const double a = 21.0 * k[4], b = 10.0 * k[1], c = 3.0 * k[0];
+  if (std::abs(a) < 1e-15) {
+    const double t = std::abs(b) > 1e-15 ? -c / b : -1.0;
+    return !(t > 0.0 && t < s) || radialSlope(k, t) > 0.0;
+  }
+  const double disc = b * b - 4.0 * a * c;
+  if (disc < 0.0) return true;
+  for (const double t : {(-b - std::sqrt(disc)) / (2.0 * a), (-b + std::sqrt(disc)) / (2.0 * a)})
+    if (t > 0.0 && t < s && radialSlope(k, t) <= 0.0) return false;
+  return true;
+}
+
+// theta_d(theta) = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8).
+double fisheyeAngle(const std::array<double, 5>& k, double theta) {
+  const double t = theta * theta;
+  return theta * (1.0 + t * (k[0] + t * (k[1] + t * (k[2] + t * k[3]))));
+}
+
+double fisheyeSlope(const std::array<double, 5>& k, double theta) {
+  const double t = theta * theta;
+  return 1.0 + t * (3.0 * k[0] + t * (5.0 * k[1] + t * (7.0 * k[2] + t * 9.0 * k[3])));
+}
+
+// The fisheye polynomial has no closed-form turning points; its slope is sampled, which is
+// exact enough for the smooth calibrations cameras have (theta < 90 degrees here).
+bool fisheyeOneToOne(const std::array<double, 5>& k, double theta) {
+  for (int i = 1; i <= 8; ++i)
+    if (fisheyeSlope(k, theta * i / 8.0) <= 0.0) return false;
+  return true;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector2d> Camera::project(const Eigen::Vector3d& p) const {
+  if (p.z() <= 1e-6) return std::nullopt;
+  const double x = p.x() / p.z(), y = p.y() / p.z();
+  const auto& k = distortion;
+  double xd = x, yd = y;
+  if (model == CameraModel::kRadialTangential) {
+    const double r2 = x * x + y * y;
+    if (!radialOneToOne(k, r2)) return std::nullopt;
+    const double radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+    xd = x * radial + 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x);
+    yd = y * radial + k[2] * (r2 + 2.0 * y * y) + 2.0 * k[3] * x * y;
+  } else if (model == CameraModel::kEquidistant) {
+    const double r = std::sqrt(x * x + y * y);
+    if (r > 1e-12) {
+      const double theta = std::atan(r);
+      if (!fisheyeOneToOne(k, theta)) return std::nullopt;
+      const double scale = fisheyeAngle(k, theta) / r;
+      xd = x * scale;
+      yd = y * scale;
+    }
+  }
+  return Eigen::Vector2d(fx * xd + cx, fy * yd + cy);
+}
+
+Eigen::Vector3d Camera::pixelRay(double u, double v) const {
+  const double xd = (u - cx) / fx, yd = (v - cy) / fy;
+  double x = xd, y = yd;
+  const auto& k = distortion;
+  if (model == CameraModel::kRadialTangential) {
+    // Fixed-point iteration, as OpenCV's undistortPoints does.
+    for (int i = 0; i < 20; ++i) {
+      const double r2 = x * x + y * y;
+      const double radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+      const double dx = 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x);
+      const double dy = k[2] * (r2 + 2.0 * y * y) + 2.0 * k[3] * x * y;
+      x = (xd - dx) / radial;
+      y = (yd - dy) / radial;
+    }
+  } else if (model == CameraModel::kEquidistant) {
+    const double theta_d = std::sqrt(xd * xd + yd * yd);
+    if (theta_d > 1e-12) {
+      double theta = theta_d;  // Newton on theta_d(theta) = theta_d
+      for (int i = 0; i < 20; ++i)
+        theta -= (fisheyeAngle(k, theta) - theta_d) / fisheyeSlope(k, theta);
+      const double scale = std::tan(theta) / theta_d;
+      x = xd * scale;
+      y = yd * scale;
+    }
+  }
+  return Eigen::Vector3d(x, y, 1.0).normalized();
+}
+
+namespace {
+bool isFinitePose(const Pose& T) {
+  return T.matrix().allFinite();
+}
+}  // namespace
 
 void SensorRig::validate() const {
   auto fail = [](const std::string& what) { throw std::invalid_argument("sensor rig: " + what); };
@@ -33,6 +150,7 @@ void SensorRig::validate() const {
   if (!(lidar.max_range_m > lidar.min_range_m && lidar.min_range_m >= 0))
     fail("lidar range must satisfy 0 <= min_range_m < max_range_m");
   if (!(rate_hz > 0)) fail("rate_hz must be positive");
+  if (!isFinitePose(T_base_lidar)) fail("T_base_lidar has a NaN or infinite entry");
   for (const auto& c : cameras) {
     const std::string n = "camera '" + c.name + "': ";
     if (c.width <= 0 || c.height <= 0) fail(n + "width and height must be positive");
@@ -44,6 +162,15 @@ void SensorRig::validate() const {
     if (!R.allFinite() || (R * R.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3 ||
         R.determinant() < 0)
       fail(n + "T_camera_lidar rotation is not a proper rotation matrix");
+    if (!isFinitePose(c.T_camera_lidar)) fail(n + "T_camera_lidar has a NaN or infinite entry");
+    for (double d : c.distortion)
+      if (!std::isfinite(d)) fail(n + "distortion coefficients must be finite");
+    if (c.model == CameraModel::kPinhole)
+      for (double d : c.distortion)
+        if (d != 0.0)
+          fail(n + "a pinhole camera has no distortion; set model: radtan or equidistant");
+    if (c.model == CameraModel::kEquidistant && c.distortion[4] != 0.0)
+      fail(n + "the equidistant model has four coefficients k1 k2 k3 k4");
   }
 }
 
@@ -63,7 +190,7 @@ SensorRig defaultSimRig() {
                           {"front", 0.0, {0.35, 0.0, -0.25}},
                           {"right", -90.0, {0.05, -0.30, -0.20}}};
   for (const auto& m : mounts) {
-    PinholeCamera cam;
+    Camera cam;
     cam.name = m.name;
     cam.width = 640;
     cam.height = 480;

@@ -1,7 +1,8 @@
-// The sensor rig: a spinning LiDAR and pinhole cameras, with the calibrations that the
+// The sensor rig: a LiDAR and cameras, with the calibrations that the
 // enrichment needs (intrinsics, LiDAR-to-camera extrinsics) and the LiDAR mounting on the base.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,18 +28,32 @@ struct LidarModel {
   Eigen::Vector3d beamDirection(int row, int col) const;
 };
 
-// Pinhole camera in the OpenCV convention (x right, y down, z forward), no distortion
-// (rectified images). T_camera_lidar maps LiDAR points into the camera frame.
-struct PinholeCamera {
+// How a camera's lens bends rays: none (rectified images), OpenCV's radial-tangential model
+// (k1 k2 p1 p2 k3) or the equidistant fisheye model of OpenCV's fisheye module (k1 k2 k3 k4).
+enum class CameraModel { kPinhole, kRadialTangential, kEquidistant };
+
+// "pinhole" | "radtan" | "equidistant"; throws std::invalid_argument naming the alternatives.
+CameraModel parseCameraModel(const std::string& name);
+const char* cameraModelName(CameraModel model);
+
+// A camera in the OpenCV convention (x right, y down, z forward). T_camera_lidar maps LiDAR
+// points into the camera frame. Points are projected through the lens model, so distorted
+// images are used as recorded.
+struct Camera {
   std::string name;
   int width = 640;
   int height = 480;
   double fx = 320.0, fy = 320.0, cx = 320.0, cy = 240.0;
+  CameraModel model = CameraModel::kPinhole;
+  // radtan: k1 k2 p1 p2 k3; equidistant: k1 k2 k3 k4 (the fifth is 0); pinhole: all 0.
+  std::array<double, 5> distortion{};
   Pose T_camera_lidar = Pose::Identity();
 
-  // Pixel of a point given in the camera frame, or nothing when it is behind the camera.
+  // Pixel of a point given in the camera frame, or nothing when it is behind the camera or
+  // outside the range where the lens model is one-to-one (a polynomial folds back there, and
+  // a far-off-axis point would land on a wrong pixel).
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& p_camera) const;
-  // Unit ray through pixel (u, v) in the camera frame.
+  // Unit ray through pixel (u, v) in the camera frame (the lens model inverted iteratively).
   Eigen::Vector3d pixelRay(double u, double v) const;
   bool inImage(const Eigen::Vector2d& uv) const {
     return uv.x() >= 0 && uv.y() >= 0 && uv.x() < width && uv.y() < height;
@@ -48,7 +63,7 @@ struct PinholeCamera {
 struct SensorRig {
   LidarModel lidar;
   Pose T_base_lidar = Pose::Identity();
-  std::vector<PinholeCamera> cameras;
+  std::vector<Camera> cameras;
   double rate_hz = 5.0;
 
   // Throws std::invalid_argument naming the field when the rig cannot be right

@@ -17,7 +17,7 @@ std::string sizeText(const Image& im) {
 
 // An image of the frame must be empty (that camera gives no colour / no class) or exactly the
 // camera's size with the expected channels; anything else is a mismatched rig and frame.
-void checkImage(const Frame& frame, const PinholeCamera& cam, const Image& im, int channels,
+void checkImage(const Frame& frame, const Camera& cam, const Image& im, int channels,
                 const char* what) {
   if (im.empty()) return;
   const bool ok = im.width == cam.width && im.height == cam.height && im.channels == channels &&
@@ -39,7 +39,7 @@ void checkInputs(const Frame& frame, const SensorRig& rig) {
                                 std::to_string(rig.cameras.size()) + " cameras (" + names + ")");
   }
   for (size_t c = 0; c < frame.cameras.size(); ++c) {
-    const PinholeCamera& cam = rig.cameras[c];
+    const Camera& cam = rig.cameras[c];
     if (cam.width <= 0 || cam.height <= 0)
       throw std::invalid_argument(where + "camera '" + cam.name + "': size " +
                                   std::to_string(cam.width) + "x" + std::to_string(cam.height) +
@@ -95,7 +95,7 @@ constexpr float kMinParallaxShiftPx = 1.0f;
 // The z-buffer test: a nearer point within `r` pixels (the neighbourhood fills the gaps between
 // the sparse LiDAR points of an occluder) that is nearer by more than the tolerance and that the
 // parallax moved towards this point, so that the camera sees it over this point's pixel.
-bool occluded(const CameraView& view, const PinholeCamera& cam, size_t i,
+bool occluded(const CameraView& view, const Camera& cam, size_t i,
               const EnrichmentConfig& config) {
   const Projection& p = view.points[i];
   const float nearer_than = p.depth - static_cast<float>(config.occlusion_tolerance_m +
@@ -155,7 +155,7 @@ void projectPoints(const Frame& frame, const SensorRig& rig, std::vector<CameraV
     const LidarPoint& lp = frame.points[i];
     const Eigen::Vector3d p(lp.x, lp.y, lp.z);
     for (size_t c = 0; c < n_cams; ++c) {
-      const PinholeCamera& cam = rig.cameras[c];
+      const Camera& cam = rig.cameras[c];
       Projection& pr = views[c].points[i];
       const Eigen::Vector3d pc = cam.T_camera_lidar * p;
       const auto uv = cam.project(pc);
@@ -202,7 +202,7 @@ int bestCamera(const Frame& frame, const SensorRig& rig, const std::vector<Camer
     if (pr.pixel < 0) continue;
     const CameraFrame& cf = frame.cameras[c];
     if (cf.rgb.empty() && cf.label.empty()) continue;  // this camera has nothing to give
-    const PinholeCamera& cam = rig.cameras[c];
+    const Camera& cam = rig.cameras[c];
     if (occluded(views[c], cam, i, config)) continue;
     // Distance to the image centre, relative to the half diagonal, so that cameras of
     // different sizes compare fairly; lens effects are smallest near the centre.

@@ -149,6 +149,21 @@ class MetaParser {
     return fromXyzQuat(v);
   }
 
+  // A list of up to N numbers (missing ones are 0: four fisheye coefficients fill five).
+  template <size_t N>
+  std::array<double, N> numbers(const YAML::Node& map, const std::string& where,
+                                const char* key) const {
+    const YAML::Node node = child(map, where, key);
+    const std::string name = field(where, key);
+    if (!node.IsSequence() || node.size() > N)
+      fail(name + ": expected a list of at most " + std::to_string(N) + " numbers, got " +
+           describe(node));
+    std::array<double, N> v{};
+    for (size_t i = 0; i < node.size(); ++i)
+      v[i] = toNumber(node[i], name + "[" + std::to_string(i) + "]");
+    return v;
+  }
+
   std::array<uint8_t, 3> color(const YAML::Node& map, const std::string& where,
                                const char* key) const {
     const YAML::Node node = child(map, where, key);
@@ -197,6 +212,9 @@ class MetaParser {
 
 constexpr long long kMaxInt = std::numeric_limits<int>::max();
 
+// Only T_base_lidar is required: the beam pattern, ranges and noise describe the simulated
+// sensor and are kept for the simulator and the contact sheet; a real recording leaves them
+// out and gets the defaults, which nothing downstream of the scans reads.
 LidarModel parseLidar(const MetaParser& p, const YAML::Node& node, Pose& T_base_lidar) {
   const std::string w = "lidar";
   p.expectMap(node, w);
@@ -204,23 +222,31 @@ LidarModel parseLidar(const MetaParser& p, const YAML::Node& node, Pose& T_base_
               {"columns", "rows", "hfov_deg", "vfov_up_deg", "vfov_down_deg", "min_range_m",
                "max_range_m", "range_noise_m", "dropout", "T_base_lidar"});
   LidarModel lidar;
-  lidar.columns = static_cast<int>(p.integer(node, w, "columns", 1, kMaxInt));
-  lidar.rows = static_cast<int>(p.integer(node, w, "rows", 1, kMaxInt));
-  lidar.hfov_deg = p.number(node, w, "hfov_deg");
-  lidar.vfov_up_deg = p.number(node, w, "vfov_up_deg");
-  lidar.vfov_down_deg = p.number(node, w, "vfov_down_deg");
-  lidar.min_range_m = p.number(node, w, "min_range_m");
-  lidar.max_range_m = p.number(node, w, "max_range_m");
-  lidar.range_noise_m = p.number(node, w, "range_noise_m");
-  lidar.dropout = p.number(node, w, "dropout");
+  auto integer = [&](const char* key, int& value) {
+    if (node[key]) value = static_cast<int>(p.integer(node, w, key, 1, kMaxInt));
+  };
+  auto number = [&](const char* key, double& value) {
+    if (node[key]) value = p.number(node, w, key);
+  };
+  integer("columns", lidar.columns);
+  integer("rows", lidar.rows);
+  number("hfov_deg", lidar.hfov_deg);
+  number("vfov_up_deg", lidar.vfov_up_deg);
+  number("vfov_down_deg", lidar.vfov_down_deg);
+  number("min_range_m", lidar.min_range_m);
+  number("max_range_m", lidar.max_range_m);
+  number("range_noise_m", lidar.range_noise_m);
+  number("dropout", lidar.dropout);
   T_base_lidar = p.pose(node, w, "T_base_lidar");
   return lidar;
 }
 
-PinholeCamera parseCamera(const MetaParser& p, const YAML::Node& node, const std::string& w) {
+Camera parseCamera(const MetaParser& p, const YAML::Node& node, const std::string& w) {
   p.expectMap(node, w);
-  p.checkKeys(node, w, {"name", "width", "height", "fx", "fy", "cx", "cy", "T_camera_lidar"});
-  PinholeCamera cam;
+  p.checkKeys(
+      node, w,
+      {"name", "width", "height", "fx", "fy", "cx", "cy", "model", "distortion", "T_camera_lidar"});
+  Camera cam;
   cam.name = p.text(node, w, "name");
   // Sizes are range-checked by SensorRig::validate(), which says what is expected.
   cam.width = static_cast<int>(p.integer(node, w, "width", -kMaxInt, kMaxInt));
@@ -229,6 +255,14 @@ PinholeCamera parseCamera(const MetaParser& p, const YAML::Node& node, const std
   cam.fy = p.number(node, w, "fy");
   cam.cx = p.number(node, w, "cx");
   cam.cy = p.number(node, w, "cy");
+  if (node["model"]) {  // optional: rectified pinhole images need neither key
+    try {
+      cam.model = parseCameraModel(p.text(node, w, "model"));
+    } catch (const std::invalid_argument& e) {
+      p.fail(MetaParser::field(w, "model") + ": " + e.what());
+    }
+    cam.distortion = p.numbers<5>(node, w, "distortion");
+  }
   cam.T_camera_lidar = p.pose(node, w, "T_camera_lidar");
   return cam;
 }
@@ -265,6 +299,7 @@ void writeMetaYaml(const fs::path& path, const DatasetInfo& info) {
   emitDouble(out, path, "rate_hz", rig.rate_hz);
   out << YAML::Key << "has_ground_truth_poses" << YAML::Value << info.has_ground_truth_poses;
   out << YAML::Key << "has_point_labels" << YAML::Value << info.has_point_labels;
+  out << YAML::Key << "has_odometry" << YAML::Value << info.has_odometry;
   if (info.first_transient_instance > 0)
     out << YAML::Key << "first_transient_instance" << YAML::Value << info.first_transient_instance;
 
@@ -297,6 +332,13 @@ void writeMetaYaml(const fs::path& path, const DatasetInfo& info) {
     for (const auto& [key, value] : intrinsics) {
       out << YAML::Key << key << YAML::Value;
       emitDouble(out, path, key, value);
+    }
+    if (cam.model != CameraModel::kPinhole) {
+      out << YAML::Key << "model" << YAML::Value << cameraModelName(cam.model);
+      out << YAML::Key << "distortion" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      const size_t n = cam.model == CameraModel::kEquidistant ? 4 : 5;
+      for (size_t i = 0; i < n; ++i) emitDouble(out, path, "distortion", cam.distortion[i]);
+      out << YAML::EndSeq;
     }
     out << YAML::Key << "T_camera_lidar" << YAML::Value;
     emitPose(out, path, "T_camera_lidar", cam.T_camera_lidar);
@@ -347,13 +389,15 @@ DatasetInfo readMetaYaml(const fs::path& path) {
            std::to_string(kDatasetFormatVersion));
   p.checkKeys(root, "",
               {"format_version", "name", "rate_hz", "has_ground_truth_poses", "has_point_labels",
-               "first_transient_instance", "lidar", "cameras", "classes"});
+               "has_odometry", "first_transient_instance", "lidar", "cameras", "classes"});
 
   DatasetInfo info;
   info.name = p.text(root, "", "name");
   info.rig.rate_hz = p.number(root, "", "rate_hz");
   info.has_ground_truth_poses = p.flag(root, "", "has_ground_truth_poses");
   info.has_point_labels = p.flag(root, "", "has_point_labels");
+  // Optional: datasets written before the key existed always had odometry in frames.csv.
+  info.has_odometry = root["has_odometry"] ? p.flag(root, "", "has_odometry") : true;
   if (root["first_transient_instance"])  // optional: datasets without traffic ids lack it
     info.first_transient_instance = static_cast<uint16_t>(
         p.integer(root, "", "first_transient_instance", 0, std::numeric_limits<uint16_t>::max()));

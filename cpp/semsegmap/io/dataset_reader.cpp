@@ -77,7 +77,7 @@ std::string sizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-Image readCameraPng(const fs::path& path, const PinholeCamera& cam, int channels) {
+Image readCameraPng(const fs::path& path, const Camera& cam, int channels) {
   requireFile(path);
   Image image = readPng(path);
   if (image.channels != channels)
@@ -173,7 +173,7 @@ Frame DatasetReader::frame(size_t i) {
   const std::string png = frameFileName(row.index, "png");
   frame.cameras.resize(info_.rig.cameras.size());
   for (size_t k = 0; k < info_.rig.cameras.size(); ++k) {
-    const PinholeCamera& cam = info_.rig.cameras[k];
+    const Camera& cam = info_.rig.cameras[k];
     const fs::path rgb_dir = dir_ / ("cam" + std::to_string(k));
     const fs::path label_dir = dir_ / ("cam" + std::to_string(k) + "_label");
     if (fs::is_directory(rgb_dir)) frame.cameras[k].rgb = readCameraPng(rgb_dir / png, cam, 3);

@@ -69,7 +69,7 @@ std::string sizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-void checkImage(const fs::path& path, const Image& image, const PinholeCamera& cam,
+void checkImage(const fs::path& path, const Image& image, const Camera& cam,
                 const char* kind, int channels) {
   if (image.channels != channels)
     throw std::invalid_argument(path.string() + ": " + kind + " image of camera '" + cam.name +
@@ -149,7 +149,7 @@ std::pair<std::vector<bool>, std::vector<bool>> DatasetWriter::checkCameras(
   }
   const bool first = !last_index_.has_value();
   for (size_t k = 0; k < n_cameras; ++k) {
-    const PinholeCamera& cam = info_.rig.cameras[k];
+    const Camera& cam = info_.rig.cameras[k];
     const fs::path rgb_path = cameraDir(dir_, k, false) / png;
     const fs::path label_png = cameraDir(dir_, k, true) / png;
     if (!first && has_rgb[k] != camera_has_rgb_[k])

@@ -152,7 +152,7 @@ std::vector<std::pair<size_t, std::filesystem::path>> listKittiFrames(
   return files;
 }
 
-PinholeCamera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam,
+Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam,
                                    const KittiCalibFile& velo_to_cam, int index) {
   const std::string suffix = "_0" + std::to_string(index);
   const std::string p_key = "P_rect" + suffix;
@@ -175,7 +175,7 @@ PinholeCamera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam,
       throw std::runtime_error(cam_to_cam.path().string() + ": " + s_key +
                                ": expected a positive integer width and height");
 
-  PinholeCamera cam;
+  Camera cam;
   cam.name = "image" + suffix;
   cam.width = static_cast<int>(size[0]);
   cam.height = static_cast<int>(size[1]);

@@ -76,12 +76,12 @@ Frame kittiScanFrame(size_t index, double timestamp_s, const std::filesystem::pa
 // std::out_of_range "<dataset>: frame <index> out of range (<frames> frames)".
 [[noreturn]] void throwFrameOutOfRange(const std::string& dataset, size_t index, size_t frames);
 
-// KITTI raw's rectified camera `index` (2 = left color) as our PinholeCamera, such that
+// KITTI raw's rectified camera `index` (2 = left color) as our Camera, such that
 // camera.project(camera.T_camera_lidar * X) equals the devkit's
 // P_rect_0i * R_rect_00 * [R|T]_velo_to_cam * X for every LiDAR point X. P_rect_0i = K [I | K^-1 p]
 // is split into the intrinsics K and a translation K^-1 p (the stereo baseline), so
 // T_camera_lidar = Translation(K^-1 p) * R_rect_00 * T_cam0_velo. Size from S_rect_0i.
-PinholeCamera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam,
+Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam,
                                    const KittiCalibFile& velo_to_cam, int index);
 
 // The Velodyne HDL-64E of KITTI (datasheet values at 10 Hz), for rigs of real KITTI data.

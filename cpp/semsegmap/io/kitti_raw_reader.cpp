@@ -144,6 +144,7 @@ KittiRawReader::KittiRawReader(const fs::path& drive_dir) : dir_(normalizedDir(d
   }
 
   info_.has_ground_truth_poses = has_oxts_;
+  info_.has_odometry = has_oxts_;  // the oxts poses serve as odometry too
   if (has_oxts_) {
     // oxts poses are IMU poses; the LiDAR pose needs the IMU-to-Velodyne mounting.
     const KittiCalibFile imu_to_velo(findCalibration(dir_, "calib_imu_to_velo.txt"));
@@ -177,7 +178,7 @@ Frame KittiRawReader::frame(size_t index) {
   Frame f = kittiScanFrame(index, files.timestamp_s, files.scan);
 
   Image rgb = readPng(files.image);
-  const PinholeCamera& cam = info_.rig.cameras.front();
+  const Camera& cam = info_.rig.cameras.front();
   if (rgb.channels != 3)
     throw std::runtime_error(files.image.string() + ": expected a 3-channel color image, found " +
                              std::to_string(rgb.channels) + " channel(s)");

@@ -158,6 +158,7 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
   info_.rig.rate_hz = 10.0;
   info_.classes = ClassTable::Default();
   info_.has_ground_truth_poses = has_poses;
+  info_.has_odometry = has_poses;  // the poses serve as odometry too
   info_.has_point_labels = has_labels;
 }
 

@@ -30,7 +30,7 @@ uint8_t toByte(float linear) {
 
 }  // namespace
 
-CameraRender renderCamera(const RayScene& scene, const PinholeCamera& camera,
+CameraRender renderCamera(const RayScene& scene, const Camera& camera,
                           const Pose& T_world_camera, const Lighting& lighting, uint64_t noise_seed,
                           bool with_depth) {
   CameraRender out;

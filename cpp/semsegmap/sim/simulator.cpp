@@ -24,6 +24,7 @@ Simulator::Simulator(const SimConfig& config)
   if (!config_.render_cameras) info_.rig.cameras.clear();
   info_.classes = ClassTable::Default();
   info_.has_ground_truth_poses = true;
+  info_.has_odometry = true;  // the simulated drifting odometry
   info_.has_point_labels = true;
   info_.first_transient_instance = kTrafficInstanceBase;
 }
@@ -54,7 +55,7 @@ Frame Simulator::frame(size_t index) {
   f.points = std::move(scan.points);
   f.point_labels = std::move(scan.labels);
   for (size_t c = 0; c < info_.rig.cameras.size(); ++c) {
-    const PinholeCamera& cam = info_.rig.cameras[c];
+    const Camera& cam = info_.rig.cameras[c];
     CameraRender r = renderCamera(*scene_, cam, T_world_lidar * cam.T_camera_lidar.inverse(),
                                   lighting_, hashKeys(seed, c + 1));
     f.cameras.push_back({std::move(r.rgb), std::move(r.label)});

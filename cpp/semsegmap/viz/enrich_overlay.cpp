@@ -33,7 +33,7 @@ cv::Scalar depthColour(double depth, const EnrichOverlayStyle& style) {
 
 }  // namespace
 
-Image drawEnrichOverlay(const Image& rgb, const PinholeCamera& camera, const EnrichedCloud& cloud,
+Image drawEnrichOverlay(const Image& rgb, const Camera& camera, const EnrichedCloud& cloud,
                         const ClassTable& classes, const std::string& legend,
                         const EnrichOverlayStyle& style) {
   if (rgb.width != camera.width || rgb.height != camera.height || rgb.channels != 3)

@@ -27,7 +27,7 @@ struct EnrichOverlayStyle {
 // is drawn, far ones first so that near ones stay on top. `legend` is written in the top-left
 // corner, one line per '\n'; in class mode, the classes that appear get swatches at the bottom.
 // Throws std::invalid_argument when rgb's size is not the camera's.
-Image drawEnrichOverlay(const Image& rgb, const PinholeCamera& camera, const EnrichedCloud& cloud,
+Image drawEnrichOverlay(const Image& rgb, const Camera& camera, const EnrichedCloud& cloud,
                         const ClassTable& classes, const std::string& legend,
                         const EnrichOverlayStyle& style = {});
 
