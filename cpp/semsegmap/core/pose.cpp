@@ -37,4 +37,12 @@ double rotationErrorDeg(const Pose& a, const Pose& b) {
   return std::abs(d.angle()) * 180.0 / M_PI;
 }
 
+Pose interpolatePose(const Pose& a, const Pose& b, double w) {
+  const Eigen::Quaterniond qa(a.linear()), qb(b.linear());
+  Pose T = Pose::Identity();
+  T.linear() = qa.slerp(w, qb).normalized().toRotationMatrix();
+  T.translation() = (1.0 - w) * a.translation() + w * b.translation();
+  return T;
+}
+
 }  // namespace semsegmap

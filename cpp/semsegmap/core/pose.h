@@ -16,6 +16,9 @@ Pose fromXyzQuat(const std::array<double, 7>& v);
 Pose planarPose(double x, double y, double z, double yaw_rad);
 double yawOf(const Pose& T);
 
+// The pose a fraction w in [0, 1] of the way from a to b: linear in position, slerp in rotation.
+Pose interpolatePose(const Pose& a, const Pose& b, double w);
+
 // Translation distance in metres and rotation angle in degrees between two poses.
 double translationError(const Pose& a, const Pose& b);
 double rotationErrorDeg(const Pose& a, const Pose& b);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "semsegmap/core/pose.h"
@@ -16,6 +17,11 @@ struct StampedPose {
 
 // The poses of a stamped trajectory, without their timestamps.
 std::vector<Pose> posesOf(const std::vector<StampedPose>& trajectory);
+
+// The pose at time t, interpolated between the two stamped poses around it (sorted by time).
+// Nothing when t lies outside the trajectory, or when the poses around it are more than
+// max_gap_s apart (a gap in the recording is not bridged by a straight line).
+std::optional<Pose> poseAt(const std::vector<StampedPose>& trajectory, double t, double max_gap_s);
 
 struct TrajectoryError {
   double rmse_m = 0.0;  // translation errors, pairwise
