@@ -10,7 +10,12 @@ packages=(
   libtorch-dev libpcl-dev libqhull-dev libfaiss-dev libceres-dev
   libopenblas0-openmp
   nlohmann-json3-dev
+  libsqlite3-dev libfastcdr-dev libzstd-dev liblz4-dev
+  librosbag-storage-dev libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
+  libtf2-msgs-dev
   gnuplot-nox
+  # make bench only: the odometry benchmark compares Open3D's registration (optional in CMake)
+  libopen3d-dev
 )
 
 missing=()

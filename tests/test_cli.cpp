@@ -69,14 +69,31 @@ const std::vector<CommandOptions> kAllCommands = {
     {"simulate-overview",
      {"world-seed", "world", "out", "cameras", "run", "frame"},
      {"max-frames", "dataset"}},
-    {"enrich", {"dataset", "frame", "out", "ply", "camera"}, {"max-frames", "config"}},
-    {"convert", {"dataset", "out", "max-frames"}, {"config", "world-seed"}},
-    {"segment", {"dataset", "config", "out", "poses", "max-frames"}, {"map", "float32"}},
+    {"enrich",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "frame", "out", "width", "ply",
+      "camera"},
+     {"max-frames", "config"}},
+    {"convert",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "out", "max-frames"},
+     {"config", "world-seed"}},
+    {"segment",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "out", "poses",
+      "max-frames"},
+     {"map", "float32"}},
     {"map",
-     {"dataset", "config", "out", "poses", "max-frames", "points", "float32"},
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "out", "poses",
+      "max-frames", "points", "float32"},
      {"world-seed", "map"}},
-    {"localize", {"dataset", "config", "map", "out", "max-frames"}, {"poses", "float32"}},
-    {"slam", {"dataset", "config", "out", "max-frames"}, {"map", "poses"}},
+    {"localize",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "map", "out",
+      "max-frames"},
+     {"poses", "float32"}},
+    {"slam",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "out", "max-frames"},
+     {"map", "poses"}},
+    {"odometry",
+     {"dataset", "rig", "ground-truth", "kitti-calib", "out", "config", "max-frames"},
+     {"map", "poses", "odometry"}},
     {"train",
      {"descriptor", "dataset", "out", "epochs", "batch", "threads", "config", "max-frames", "cache",
       "anchors-per-epoch", "lr", "seed", "points", "history"},
@@ -364,6 +381,26 @@ TEST(Cli, RuntimeErrorsExitOne) {
   EXPECT_EQ(r.err.rfind("semsegmap localize: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("missing.map"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("usage error"), std::string::npos);
+}
+
+// A dataset without odometry (here a folder of scans, no pose file) is refused before any frame
+// is processed, with the options that would give it poses; nothing runs on identity poses.
+TEST(Cli, NoOdometryIsRefusedUpFrontNamingTheOptions) {
+  TempDir tmp;
+  {
+    std::ofstream bin(tmp.path() / "000000.bin", std::ios::binary);
+    const float point[4] = {5.0f, 1.0f, 0.5f, 0.0f};
+    bin.write(reinterpret_cast<const char*>(point), sizeof(point));
+  }
+  if (!SEMSEGMAP_WITH_TORCH) GTEST_SKIP() << "the shipped configurations name learned descriptors";
+  const std::string config = "config/segmap.yaml";  // ctest runs in the source tree
+  for (const std::string command : {"map", "slam"}) {
+    const Result r = run(command + " --dataset folder:" + tmp.path().string() + " --config " +
+                         config + " --out " + (tmp.path() / "out").string());
+    EXPECT_EQ(r.code, 1) << command << ": " << r.err;
+    EXPECT_NE(r.err.find("has no odometry: give --odometry FILE"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(tmp.path() / "out")) << command;
+  }
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ namespace {
 // A 40 x 30 camera with a 90-degree horizontal field of view, looking along the LiDAR's
 // direction `yaw_deg` (LiDAR x forward, y left, z up; camera x right, y down, z forward).
 Camera makeCamera(const std::string& name, double yaw_deg = 0.0,
-                         const Eigen::Vector3d& offset_in_lidar = Eigen::Vector3d::Zero()) {
+                  const Eigen::Vector3d& offset_in_lidar = Eigen::Vector3d::Zero()) {
   Camera cam;
   cam.name = name;
   cam.width = 40;
@@ -65,8 +65,7 @@ CameraFrame patternImages(const Camera& cam) {
   return cf;
 }
 
-CameraFrame uniformImages(const Camera& cam, uint8_t r, uint8_t g, uint8_t b,
-                          ClassId label) {
+CameraFrame uniformImages(const Camera& cam, uint8_t r, uint8_t g, uint8_t b, ClassId label) {
   CameraFrame cf{Image(cam.width, cam.height, 3), Image(cam.width, cam.height, 1)};
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {

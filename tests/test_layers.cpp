@@ -13,8 +13,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::set<std::string> kStages = {"enrich",   "local_map", "segment",  "describe",
-                                       "localize", "graph",     "pipeline", "learn"};
+const std::set<std::string> kStages = {"enrich", "local_map", "segment",  "describe", "localize",
+                                       "graph",  "odometry",  "pipeline", "learn"};
 
 std::set<std::string> with(std::set<std::string> s, const std::set<std::string>& more) {
   s.insert(more.begin(), more.end());
@@ -24,7 +24,7 @@ std::set<std::string> with(std::set<std::string> s, const std::set<std::string>&
 // Folder -> the folders it may include from (its own is always allowed).
 std::map<std::string, std::set<std::string>> makeTable() {
   const std::set<std::string> stages = {"core",     "enrich",   "local_map", "segment",
-                                        "describe", "localize", "graph"};
+                                        "describe", "localize", "graph",     "odometry"};
   const std::set<std::string> below_io = with(stages, {"pipeline", "learn"});
   const std::set<std::string> below_viz = with(below_io, {"io", "sim", "datasets"});
   return {
@@ -36,6 +36,7 @@ std::map<std::string, std::set<std::string>> makeTable() {
       {"describe", {"core", "local_map", "segment"}},
       {"localize", {"core"}},
       {"graph", {"core"}},
+      {"odometry", {"core"}},
       {"pipeline", stages},
       {"learn", with(stages, {"pipeline"})},
       {"io", below_io},

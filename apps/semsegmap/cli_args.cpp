@@ -133,9 +133,16 @@ OptionSpec maxFramesOption(const std::string& help) {
 const char* const kDatasetNotes =
 #if SEMSEGMAP_WITH_SIM
     "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,\n"
-    "  sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small]\n";
+    "  folder:DIR[,rig=FILE][,times=FILE][,tolerance=S] (scans and pictures, docs/rig-format.md),\n"
+    "  rosbag:FILE.bag|FILE.db3|FILE.mcap|DIR[,lidar=T][,camera=T;T|none][,odometry=T]\n"
+    "    [,base_frame=F][,odom_frame=F][,tolerance=S] (ROS 1 and ROS 2 bags),\n"
+    "  "
+    "sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small][,sweep=1]\n";
 #else
-    "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH\n"
+    "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,\n"
+    "  folder:DIR[,rig=FILE][,times=FILE][,tolerance=S] (scans and pictures, docs/rig-format.md),\n"
+    "  rosbag:FILE.bag|FILE.db3|FILE.mcap|DIR[,lidar=T][,camera=T;T|none][,odometry=T]\n"
+    "    [,base_frame=F][,odom_frame=F][,tolerance=S] (ROS 1 and ROS 2 bags)\n"
     "  (not sim:, this build has no simulator: reconfigure with -DSEMSEGMAP_WITH_SIM=ON)\n";
 #endif
 

@@ -101,6 +101,7 @@ const CommandSpec& segmentCommand();
 const CommandSpec& mapCommand();
 const CommandSpec& localizeCommand();
 const CommandSpec& slamCommand();
+const CommandSpec& odometryCommand();
 const CommandSpec& trainCommand();
 const std::vector<const CommandSpec*>& evalCommands();  // "eval segmentation", ...
 

@@ -3,8 +3,8 @@
 #include <iostream>
 
 #include "cli_args.h"
+#include "dataset_args.h"
 #include "progress.h"
-#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/dataset_writer.h"
 
 namespace semsegmap::app {
@@ -12,7 +12,7 @@ namespace semsegmap::app {
 namespace {
 
 int runConvert(const CliArgs& a) {
-  auto source = openDataset(a.get("dataset"));
+  auto source = openDatasetArg(a);
   const size_t n = a.frameLimit(source->size());
   DatasetWriter writer(a.get("out"), source->info());
   Progress progress("convert", n);
@@ -29,15 +29,13 @@ int runConvert(const CliArgs& a) {
 
 const CommandSpec& convertCommand() {
   static const CommandSpec command{
-      "convert",
-      "writes any dataset the command line reads in the project's own format",
-      {
-          {"dataset", Value::kText, "SPEC", "", "the dataset to convert", kRequired},
-          {"out", Value::kText, "DIR", "", "dataset directory to write", kRequired},
-          maxFramesOption(),
-      },
-      kDatasetNotes,
-      runConvert};
+      "convert", "writes any dataset the command line reads in the project's own format",
+      datasetOptions("the dataset to convert",
+                     {
+                         {"out", Value::kText, "DIR", "", "dataset directory to write", kRequired},
+                         maxFramesOption(),
+                     }),
+      kDatasetNotes, runConvert};
   return command;
 }
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "cli_args.h"
-#include "semsegmap/datasets/open_dataset.h"
+#include "dataset_args.h"
 #include "semsegmap/enrich/enricher.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/ply_writer.h"
@@ -18,7 +18,7 @@ namespace {
 int runEnrich(const CliArgs& a) {
   const std::string spec = a.get("dataset");
   const std::string out = a.get("out");
-  auto source = openDataset(spec);
+  auto source = openDatasetArg(a);
   const DatasetInfo& info = source->info();
 
   const size_t frame_index = a.getCount("frame");
@@ -52,6 +52,7 @@ int runEnrich(const CliArgs& a) {
   // Small images (the simulator's 640 x 480) see neighbouring LiDAR rings 2-3 pixels apart:
   // bigger dots would hide the picture they are meant to be compared with.
   style.dot_radius_px = frame.cameras[camera].rgb.width >= 1000 ? 1 : 0;
+  style.max_width = static_cast<int>(a.getCount("width"));
   const std::string legend = info.name + "\nframe " + std::to_string(frame_index) + ": " +
                              std::to_string(coloured) + " / " + std::to_string(cloud.size()) +
                              " points coloured" +
@@ -71,18 +72,19 @@ int runEnrich(const CliArgs& a) {
 
 const CommandSpec& enrichCommand() {
   static const CommandSpec command{
-      "enrich",
-      "one frame's LiDAR points coloured from the cameras, drawn over a camera image",
-      {
-          {"dataset", Value::kText, "SPEC", "", "the dataset", kRequired},
-          {"frame", Value::kCount, "I", "0", "the frame to enrich"},
-          {"out", Value::kText, "FILE.png", "", "the camera image with the points", kRequired},
-          {"ply", Value::kText, "FILE.ply", "", "also write the enriched cloud"},
-          {"camera", Value::kCount, "K", "",
-           "the camera to draw on (default: 1, the front one, with three cameras, else 0)"},
-      },
-      kDatasetNotes,
-      runEnrich};
+      "enrich", "one frame's LiDAR points coloured from the cameras, drawn over a camera image",
+      datasetOptions(
+          "the dataset",
+          {
+              {"frame", Value::kCount, "I", "0", "the frame to enrich"},
+              {"out", Value::kText, "FILE.png", "", "the camera image with the points", kRequired},
+              {"width", Value::kCount, "W", "0",
+               "shrink the picture to this width, 0: as the camera"},
+              {"ply", Value::kText, "FILE.ply", "", "also write the enriched cloud"},
+              {"camera", Value::kCount, "K", "",
+               "the camera to draw on (default: 1, the front one, with three cameras, else 0)"},
+          }),
+      kDatasetNotes, runEnrich};
   return command;
 }
 

@@ -4,9 +4,9 @@
 #include <iostream>
 
 #include "cli_args.h"
+#include "dataset_args.h"
 #include "progress.h"
 #include "semsegmap/core/atomic_file.h"
-#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/eval/localization_picture.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/map_file.h"
@@ -26,7 +26,7 @@ int runLocalize(const CliArgs& a) {
   std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
   checkMapCompatible(map_path, *map, descriptorName(describer->kind()), describer->fingerprint(),
                      describer->dimension());
-  auto source = openDataset(a.get("dataset"));
+  auto source = openDatasetArg(a);
   std::filesystem::create_directories(out);
 
   Progress progress("localize", 0);
@@ -67,18 +67,17 @@ int runLocalize(const CliArgs& a) {
 
 const CommandSpec& localizeCommand() {
   static const CommandSpec command{
-      "localize",
-      "localizes a run against a target map -> localizations.csv, summary.json, .png",
-      {
-          {"dataset", Value::kText, "SPEC", "", "the run to localize", kRequired},
-          {"config", Value::kText, "FILE", "",
-           "pipeline configuration, the one the map was built with", kRequired},
-          {"map", Value::kText, "MAP", "", "the target map (semsegmap map)", kRequired},
-          {"out", Value::kText, "DIR", "", "output folder", kRequired},
-          maxFramesOption(),
-      },
-      kDatasetNotes,
-      runLocalize};
+      "localize", "localizes a run against a target map -> localizations.csv, summary.json, .png",
+      datasetOptions(
+          "the run to localize",
+          {
+              {"config", Value::kText, "FILE", "",
+               "pipeline configuration, the one the map was built with", kRequired},
+              {"map", Value::kText, "MAP", "", "the target map (semsegmap map)", kRequired},
+              {"out", Value::kText, "DIR", "", "output folder", kRequired},
+              maxFramesOption(),
+          }),
+      kDatasetNotes, runLocalize};
   return command;
 }
 

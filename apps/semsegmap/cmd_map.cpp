@@ -3,8 +3,8 @@
 #include <iostream>
 
 #include "cli_args.h"
+#include "dataset_args.h"
 #include "progress.h"
-#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/map_file.h"
 #include "semsegmap/io/model_file.h"
@@ -23,7 +23,7 @@ int runMap(const CliArgs& a) {
   // The model first: a missing one, or a descriptor this build has not, fails before the data.
   std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
   const std::filesystem::path out = a.get("out");
-  auto source = openDataset(a.get("dataset"));
+  auto source = openDatasetArg(a);
   const std::string poses = a.has("poses")                          ? a.get("poses")
                             : source->info().has_ground_truth_poses ? "gt"
                                                                     : "odom";
@@ -65,20 +65,20 @@ int runMap(const CliArgs& a) {
 
 const CommandSpec& mapCommand() {
   static const CommandSpec command{
-      "map",
-      "builds a target map from a mapping run and saves it (docs/map-format.md)",
-      {
-          {"dataset", Value::kText, "SPEC", "", "the mapping run", kRequired},
-          {"config", Value::kText, "FILE", "", "pipeline configuration, config/*.yaml", kRequired},
-          {"out", Value::kText, "MAP", "", "the map file to write", kRequired},
-          {"poses", Value::kText, "gt|odom|slam", "",
-           "poses the map is built with (default: gt when the data has them, else odom)"},
-          maxFramesOption(),
-          {"points", Value::kCount, "N", "0", "points kept per segment for pictures, 0..65535"},
-          {"float32", Value::kFlag, "", "", "store descriptors as float32 instead of float16"},
-      },
-      kDatasetNotes,
-      runMap};
+      "map", "builds a target map from a mapping run and saves it (docs/map-format.md)",
+      datasetOptions(
+          "the mapping run",
+          {
+              {"config", Value::kText, "FILE", "", "pipeline configuration, config/*.yaml",
+               kRequired},
+              {"out", Value::kText, "MAP", "", "the map file to write", kRequired},
+              {"poses", Value::kText, "gt|odom|slam", "",
+               "poses the map is built with (default: gt when the data has them, else odom)"},
+              maxFramesOption(),
+              {"points", Value::kCount, "N", "0", "points kept per segment for pictures, 0..65535"},
+              {"float32", Value::kFlag, "", "", "store descriptors as float32 instead of float16"},
+          }),
+      kDatasetNotes, runMap};
   return command;
 }
 

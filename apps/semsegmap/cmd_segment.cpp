@@ -4,8 +4,8 @@
 #include <iostream>
 
 #include "cli_args.h"
+#include "dataset_args.h"
 #include "progress.h"
-#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/segments_io.h"
 #include "semsegmap/pipeline/pipeline.h"
@@ -39,7 +39,7 @@ void printSummary(const std::vector<Segment>& segments, size_t n, size_t merges,
 int runSegment(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
   const std::filesystem::path out = a.get("out");
-  auto source = openDataset(a.get("dataset"));
+  auto source = openDatasetArg(a);
   const PoseSource poses = parsePoseSource(a.has("poses")                          ? a.get("poses")
                                            : source->info().has_ground_truth_poses ? "gt"
                                                                                    : "odom");
@@ -82,18 +82,18 @@ int runSegment(const CliArgs& a) {
 
 const CommandSpec& segmentCommand() {
   static const CommandSpec command{
-      "segment",
-      "enrichment + local map + incremental segmentation -> segments.csv, .ply, .png",
-      {
-          {"dataset", Value::kText, "SPEC", "", "the dataset", kRequired},
-          {"config", Value::kText, "FILE", "", "pipeline configuration, config/*.yaml", kRequired},
-          {"out", Value::kText, "DIR", "", "output folder", kRequired},
-          {"poses", Value::kText, "gt|odom", "",
-           "poses the local map is built with (default: gt when the data has them, else odom)"},
-          maxFramesOption(),
-      },
-      kDatasetNotes,
-      runSegment};
+      "segment", "enrichment + local map + incremental segmentation -> segments.csv, .ply, .png",
+      datasetOptions(
+          "the dataset",
+          {
+              {"config", Value::kText, "FILE", "", "pipeline configuration, config/*.yaml",
+               kRequired},
+              {"out", Value::kText, "DIR", "", "output folder", kRequired},
+              {"poses", Value::kText, "gt|odom", "",
+               "poses the local map is built with (default: gt when the data has them, else odom)"},
+              maxFramesOption(),
+          }),
+      kDatasetNotes, runSegment};
   return command;
 }
 

@@ -5,9 +5,9 @@
 #include <optional>
 
 #include "cli_args.h"
+#include "dataset_args.h"
 #include "progress.h"
 #include "semsegmap/core/atomic_file.h"
-#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/io/run_output.h"
@@ -22,15 +22,16 @@ namespace {
 int runSlamCommand(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
   const std::filesystem::path out = a.get("out");
-  auto source = openDataset(a.get("dataset"));
+  auto source = openDatasetArg(a);
   std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
-  std::filesystem::create_directories(out);
 
   Progress progress("slam", 0);
   RunOptions options;
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   const SlamRun run = runSlam(*source, config, describer, options);
+  // Made only now: a run refused up front (a dataset without odometry) leaves nothing behind.
+  std::filesystem::create_directories(out);
 
   writeTum(out / "trajectory_tum.txt", run.trajectory);
   writeKitti(out / "trajectory_kitti.txt", run.trajectory);
@@ -72,16 +73,15 @@ int runSlamCommand(const CliArgs& a) {
 
 const CommandSpec& slamCommand() {
   static const CommandSpec command{
-      "slam",
-      "mapping with loop closure on odometry -> trajectories, loops.csv, slam.png",
-      {
-          {"dataset", Value::kText, "SPEC", "", "the run to map", kRequired},
-          {"config", Value::kText, "FILE", "", "pipeline configuration, config/*.yaml", kRequired},
-          {"out", Value::kText, "DIR", "", "output folder", kRequired},
-          maxFramesOption(),
-      },
-      kDatasetNotes,
-      runSlamCommand};
+      "slam", "mapping with loop closure on odometry -> trajectories, loops.csv, slam.png",
+      datasetOptions("the run to map",
+                     {
+                         {"config", Value::kText, "FILE", "",
+                          "pipeline configuration, config/*.yaml", kRequired},
+                         {"out", Value::kText, "DIR", "", "output folder", kRequired},
+                         maxFramesOption(),
+                     }),
+      kDatasetNotes, runSlamCommand};
   return command;
 }
 

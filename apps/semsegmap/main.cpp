@@ -24,7 +24,7 @@ const std::vector<const CommandSpec*>& commands() {
     c = {&simulateCommand(), &simulateOverviewCommand()};
 #endif
     c.insert(c.end(), {&enrichCommand(), &convertCommand(), &segmentCommand(), &mapCommand(),
-                       &localizeCommand(), &slamCommand()});
+                       &localizeCommand(), &slamCommand(), &odometryCommand()});
 #if SEMSEGMAP_WITH_TORCH
     c.push_back(&trainCommand());
 #endif

@@ -32,6 +32,8 @@ class FrameSource {
   virtual size_t size() const = 0;
   // Random access; throws with a message naming the file when a frame cannot be produced.
   virtual Frame frame(size_t index) = 0;
+  // The time of a frame; sources that know it without reading the frame say so faster.
+  virtual double frameTime(size_t index) { return frame(index).timestamp_s; }
 };
 
 // How many frames a run reads of `source`: the first max_frames, or all when it is 0.

@@ -85,6 +85,9 @@ bool fisheyeOneToOne(const std::array<double, 5>& k, double theta) {
 
 std::optional<Eigen::Vector2d> Camera::project(const Eigen::Vector3d& p) const {
   if (p.z() <= 1e-6) return std::nullopt;
+  // Rectified images keep the arithmetic (and so the rounding) pixels always had.
+  if (model == CameraModel::kPinhole)
+    return Eigen::Vector2d(fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy);
   const double x = p.x() / p.z(), y = p.y() / p.z();
   const auto& k = distortion;
   double xd = x, yd = y;

@@ -1,10 +1,17 @@
 #include "semsegmap/datasets/open_dataset.h"
 
 #include <filesystem>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
+#include "semsegmap/datasets/lidar_odometry_source.h"
+#include "semsegmap/datasets/pose_files.h"
 #include "semsegmap/io/dataset_reader.h"
+#include "semsegmap/io/folder_reader.h"
+#if SEMSEGMAP_WITH_ROS
+#include "semsegmap/io/rosbag_reader.h"
+#endif
 #include "semsegmap/io/kitti_raw_reader.h"
 #include "semsegmap/io/nclt_reader.h"
 #include "semsegmap/io/semantic_kitti_reader.h"
@@ -57,6 +64,8 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
       preset = value;
     else if (key == "cameras")
       config.render_cameras = parseUnsigned(spec, key, value) != 0;
+    else if (key == "sweep")
+      config.lidar_sweep = parseUnsigned(spec, key, value) != 0;
     else
       throw std::invalid_argument("dataset '" + spec + "': unknown key '" + key + "'");
   }
@@ -73,7 +82,39 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
 
 }  // namespace
 
-std::unique_ptr<FrameSource> openDataset(const std::string& spec) {
+namespace {
+
+std::unique_ptr<FrameSource> openFolder(const std::string& spec, const std::string& args,
+                                        const DatasetOptions& options) {
+  FolderOptions folder;
+  folder.rig = options.rig;
+  const std::filesystem::path dir = parseFolderSpec(spec, args, folder);
+  return std::make_unique<FolderReader>(dir, folder);
+}
+
+#if SEMSEGMAP_WITH_ROS
+// rosbag:PATH[,key=value...]: the bag file or folder, then the reader's options.
+std::unique_ptr<FrameSource> openRosbag(const std::string& spec, const std::string& args) {
+  const auto comma = args.find(',');
+  const std::string path = args.substr(0, comma);
+  if (path.empty()) throw std::invalid_argument("dataset '" + spec + "': no bag after rosbag:");
+  RosbagOptions options;
+  try {
+    if (comma != std::string::npos) options = parseRosbagOptions(args.substr(comma + 1));
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("dataset '" + spec + "': " + e.what());
+  }
+  return std::make_unique<RosbagReader>(path, options);
+}
+#else
+std::unique_ptr<FrameSource> openRosbag(const std::string& spec, const std::string&) {
+  throw std::runtime_error("dataset '" + spec +
+                           "': this build reads no ROS bags (reconfigure with "
+                           "-DSEMSEGMAP_WITH_ROS=ON)");
+}
+#endif
+
+std::unique_ptr<FrameSource> openSource(const std::string& spec, const DatasetOptions& options) {
   const auto colon = spec.find(':');
   if (colon != std::string::npos) {
     const std::string kind = spec.substr(0, colon), rest = spec.substr(colon + 1);
@@ -81,15 +122,38 @@ std::unique_ptr<FrameSource> openDataset(const std::string& spec) {
     if (kind == "semantickitti") return std::make_unique<SemanticKittiReader>(rest);
     if (kind == "nclt") return std::make_unique<NcltReader>(rest);
     if (kind == "sim") return openSimulator(spec, rest);
+    if (kind == "folder") return openFolder(spec, rest, options);
+    if (kind == "rosbag") return openRosbag(spec, rest);
     // Anything else with a colon may still be a directory name.
     if (!std::filesystem::exists(spec))
       throw std::invalid_argument(
           "dataset '" + spec + "': unknown kind '" + kind +
-          "' (expected kitti-raw:, semantickitti:, nclt:, sim: or a directory)");
+          "' (expected kitti-raw:, semantickitti:, nclt:, sim:, folder:, rosbag: or a directory)");
   }
   if (!std::filesystem::is_directory(spec))
     throw std::runtime_error(spec + ": no such dataset directory");
+  if (!std::filesystem::exists(std::filesystem::path(spec) / "meta.yaml")) {
+    std::cerr << "note: " << spec << " has no meta.yaml: reading it as folder:" << spec << "\n";
+    return openFolder("folder:" + spec, spec, options);
+  }
   return std::make_unique<DatasetReader>(spec);
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetOptions& options) {
+  auto source = openSource(spec, options);
+  if (!options.rig.empty() && dynamic_cast<FolderReader*>(source.get()) == nullptr)
+    throw std::invalid_argument("--rig: dataset '" + spec +
+                                "' brings its own calibration; a rig file is for folder: datasets");
+  const bool lidar_odometry = options.odometry == "lidar";
+  PoseFileOptions poses;
+  if (!lidar_odometry) poses.odometry = options.odometry;
+  poses.ground_truth = options.ground_truth;
+  poses.kitti_calib = options.kitti_calib;
+  source = withPoseFiles(std::move(source), poses);
+  return lidar_odometry ? withLidarOdometry(std::move(source), options.lidar_odometry)
+                        : std::move(source);
 }
 
 }  // namespace semsegmap

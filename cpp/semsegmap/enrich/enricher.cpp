@@ -95,8 +95,7 @@ constexpr float kMinParallaxShiftPx = 1.0f;
 // The z-buffer test: a nearer point within `r` pixels (the neighbourhood fills the gaps between
 // the sparse LiDAR points of an occluder) that is nearer by more than the tolerance and that the
 // parallax moved towards this point, so that the camera sees it over this point's pixel.
-bool occluded(const CameraView& view, const Camera& cam, size_t i,
-              const EnrichmentConfig& config) {
+bool occluded(const CameraView& view, const Camera& cam, size_t i, const EnrichmentConfig& config) {
   const Projection& p = view.points[i];
   const float nearer_than = p.depth - static_cast<float>(config.occlusion_tolerance_m +
                                                          config.occlusion_tolerance_rel * p.depth);

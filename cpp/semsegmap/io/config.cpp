@@ -58,7 +58,7 @@ YAML::Node loadConfigRoot(const std::filesystem::path& path) {
     throw std::runtime_error(path.string() + ": expected a mapping at the top level");
   const std::map<std::string, bool> sections = {
       {"enrichment", true},   {"local_map", true},  {"segmentation", true}, {"descriptor", true},
-      {"localization", true}, {"target_map", true}, {"loop_closure", true}};
+      {"localization", true}, {"target_map", true}, {"loop_closure", true}, {"odometry", true}};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (!sections.count(key))
@@ -101,6 +101,48 @@ void checkPipelineConfig(const std::filesystem::path& path, const PipelineConfig
 }
 
 }  // namespace
+
+namespace {
+
+void readOdometrySection(const std::filesystem::path& path, const YAML::Node& root,
+                         OdometryConfig& c) {
+  std::string metric;
+  readSection(path, root, "odometry",
+              {{"voxel_size_m", set(c.voxel_size_m)},
+               {"max_range_m", set(c.max_range_m)},
+               {"min_range_m", set(c.min_range_m)},
+               {"max_points_per_voxel", set(c.max_points_per_voxel)},
+               {"initial_threshold_m", set(c.initial_threshold_m)},
+               {"min_motion_m", set(c.min_motion_m)},
+               {"deskew", set(c.deskew)},
+               {"min_points", set(c.min_points)},
+               {"metric", set(metric)},
+               {"max_iterations", set(c.icp.max_iterations)},
+               {"convergence", set(c.icp.convergence)},
+               {"degeneracy_ratio", set(c.icp.degeneracy_ratio)},
+               {"min_correspondences", set(c.icp.min_correspondences)}});
+  auto check = [&](bool ok, const std::string& what) {
+    if (!ok) throw std::runtime_error(path.string() + ": odometry." + what);
+  };
+  check(metric.empty() || metric == "point_to_plane" || metric == "point_to_point",
+        "metric: expected point_to_plane or point_to_point, got '" + metric + "'");
+  if (metric == "point_to_point") c.icp.metric = IcpMetric::kPointToPoint;
+  check(c.voxel_size_m > 0, "voxel_size_m: must be positive");
+  check(c.min_range_m >= 0 && c.max_range_m > c.min_range_m,
+        "max_range_m: must exceed min_range_m (and that must not be negative)");
+  check(c.max_points_per_voxel >= 1, "max_points_per_voxel: must be at least 1");
+  check(c.initial_threshold_m > 0, "initial_threshold_m: must be positive");
+  check(c.icp.max_iterations >= 1, "max_iterations: must be at least 1");
+  check(c.icp.degeneracy_ratio >= 0, "degeneracy_ratio: must not be negative");
+}
+
+}  // namespace
+
+OdometryConfig loadOdometryConfig(const std::filesystem::path& path) {
+  OdometryConfig c;
+  readOdometrySection(path, loadConfigRoot(path), c);
+  return c;
+}
 
 PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
   const YAML::Node root = loadConfigRoot(path);
@@ -160,6 +202,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"loop_rotation_sigma_rad", set(lc.graph.loop_rotation_sigma_rad)}});
 
   checkPipelineConfig(path, c);
+  OdometryConfig odometry;  // checked here too, so that a typo fails every command
+  readOdometrySection(path, root, odometry);
   return c;
 }
 

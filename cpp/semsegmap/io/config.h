@@ -4,11 +4,16 @@
 
 #include <filesystem>
 
+#include "semsegmap/odometry/lidar_odometry.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
 namespace semsegmap {
 
 // Throws std::runtime_error "<file>: <section.key>: <what was wrong>".
 PipelineConfig loadPipelineConfig(const std::filesystem::path& path);
+
+// The `odometry:` section of the same file (LiDAR odometry, odometry/lidar_odometry.h): the
+// defaults when it has none. Same errors.
+OdometryConfig loadOdometryConfig(const std::filesystem::path& path);
 
 }  // namespace semsegmap

@@ -14,6 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/io/yaml_fields.h"
 
 namespace semsegmap {
 namespace fs = std::filesystem;
@@ -83,165 +84,24 @@ void emitPose(YAML::Emitter& out, const fs::path& path, const char* field, const
   out << YAML::EndSeq;
 }
 
-// Reads meta.yaml fields with messages "<path>: <field>: <what was wrong>".
-class MetaParser {
- public:
-  explicit MetaParser(const fs::path& path) : path_(path.string()) {}
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(path_ + ": " + what);
-  }
-
-  void expectMap(const YAML::Node& node, const std::string& where) const {
-    if (!node.IsMap()) fail(where + ": expected a mapping, got " + describe(node));
-  }
-
-  void checkKeys(const YAML::Node& map, const std::string& where,
-                 std::initializer_list<const char*> allowed) const {
-    for (const auto& entry : map) {
-      const std::string key = entry.first.Scalar();
-      bool ok = false;
-      for (const char* a : allowed) ok = ok || key == a;
-      if (!ok)
-        fail("unknown key '" + key + "' " + (where.empty() ? "at the top level" : "in " + where));
-    }
-  }
-
-  YAML::Node child(const YAML::Node& map, const std::string& where, const char* key) const {
-    const YAML::Node node = map[key];
-    if (!node.IsDefined()) fail(field(where, key) + ": missing");
-    return node;
-  }
-
-  double number(const YAML::Node& map, const std::string& where, const char* key) const {
-    return toNumber(child(map, where, key), field(where, key));
-  }
-
-  long long integer(const YAML::Node& map, const std::string& where, const char* key, long long lo,
-                    long long hi) const {
-    return toInteger(child(map, where, key), field(where, key), lo, hi);
-  }
-
-  bool flag(const YAML::Node& map, const std::string& where, const char* key) const {
-    const YAML::Node node = child(map, where, key);
-    bool value = false;
-    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value))
-      fail(field(where, key) + ": expected true or false, got " + describe(node));
-    return value;
-  }
-
-  std::string text(const YAML::Node& map, const std::string& where, const char* key) const {
-    const YAML::Node node = child(map, where, key);
-    if (!node.IsScalar()) fail(field(where, key) + ": expected a string, got " + describe(node));
-    return node.Scalar();
-  }
-
-  Pose pose(const YAML::Node& map, const std::string& where, const char* key) const {
-    const YAML::Node node = child(map, where, key);
-    const std::string name = field(where, key);
-    if (!node.IsSequence() || node.size() != 7)
-      fail(name + ": expected [x, y, z, qx, qy, qz, qw], got " + describe(node));
-    std::array<double, 7> v{};
-    for (size_t i = 0; i < 7; ++i) v[i] = toNumber(node[i], name + "[" + std::to_string(i) + "]");
-    // Normalising (fromXyzQuat) forgives rounded hand-written quaternions, but not a zero one.
-    if (std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]) < 1e-9)
-      fail(name + ": the quaternion (qx, qy, qz, qw) has zero length");
-    return fromXyzQuat(v);
-  }
-
-  // A list of up to N numbers (missing ones are 0: four fisheye coefficients fill five).
-  template <size_t N>
-  std::array<double, N> numbers(const YAML::Node& map, const std::string& where,
-                                const char* key) const {
-    const YAML::Node node = child(map, where, key);
-    const std::string name = field(where, key);
-    if (!node.IsSequence() || node.size() > N)
-      fail(name + ": expected a list of at most " + std::to_string(N) + " numbers, got " +
-           describe(node));
-    std::array<double, N> v{};
-    for (size_t i = 0; i < node.size(); ++i)
-      v[i] = toNumber(node[i], name + "[" + std::to_string(i) + "]");
-    return v;
-  }
-
-  std::array<uint8_t, 3> color(const YAML::Node& map, const std::string& where,
-                               const char* key) const {
-    const YAML::Node node = child(map, where, key);
-    const std::string name = field(where, key);
-    if (!node.IsSequence() || node.size() != 3)
-      fail(name + ": expected [r, g, b], got " + describe(node));
-    std::array<uint8_t, 3> rgb{};
-    for (size_t i = 0; i < 3; ++i)
-      rgb[i] =
-          static_cast<uint8_t>(toInteger(node[i], name + "[" + std::to_string(i) + "]", 0, 255));
-    return rgb;
-  }
-
-  static std::string field(const std::string& where, const char* key) {
-    return where.empty() ? key : where + "." + key;
-  }
-
- private:
-  static std::string describe(const YAML::Node& node) {
-    if (node.IsScalar()) return "'" + node.Scalar() + "'";
-    if (node.IsSequence()) return "a list";
-    if (node.IsMap()) return "a mapping";
-    return "nothing";
-  }
-
-  double toNumber(const YAML::Node& node, const std::string& name) const {
-    double value = 0;
-    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value))
-      fail(name + ": expected a finite number, got " + describe(node));
-    return value;
-  }
-
-  long long toInteger(const YAML::Node& node, const std::string& name, long long lo,
-                      long long hi) const {
-    long long value = 0;
-    if (!node.IsScalar() || !YAML::convert<long long>::decode(node, value))
-      fail(name + ": expected an integer, got " + describe(node));
-    if (value < lo || value > hi)
-      fail(name + ": " + std::to_string(value) + " is outside [" + std::to_string(lo) + ", " +
-           std::to_string(hi) + "]");
-    return value;
-  }
-
-  std::string path_;
-};
-
 constexpr long long kMaxInt = std::numeric_limits<int>::max();
 
 // Only T_base_lidar is required: the beam pattern, ranges and noise describe the simulated
 // sensor and are kept for the simulator and the contact sheet; a real recording leaves them
 // out and gets the defaults, which nothing downstream of the scans reads.
-LidarModel parseLidar(const MetaParser& p, const YAML::Node& node, Pose& T_base_lidar) {
+LidarModel parseLidar(const YamlFields& p, const YAML::Node& node, Pose& T_base_lidar) {
   const std::string w = "lidar";
   p.expectMap(node, w);
   p.checkKeys(node, w,
               {"columns", "rows", "hfov_deg", "vfov_up_deg", "vfov_down_deg", "min_range_m",
                "max_range_m", "range_noise_m", "dropout", "T_base_lidar"});
   LidarModel lidar;
-  auto integer = [&](const char* key, int& value) {
-    if (node[key]) value = static_cast<int>(p.integer(node, w, key, 1, kMaxInt));
-  };
-  auto number = [&](const char* key, double& value) {
-    if (node[key]) value = p.number(node, w, key);
-  };
-  integer("columns", lidar.columns);
-  integer("rows", lidar.rows);
-  number("hfov_deg", lidar.hfov_deg);
-  number("vfov_up_deg", lidar.vfov_up_deg);
-  number("vfov_down_deg", lidar.vfov_down_deg);
-  number("min_range_m", lidar.min_range_m);
-  number("max_range_m", lidar.max_range_m);
-  number("range_noise_m", lidar.range_noise_m);
-  number("dropout", lidar.dropout);
+  readOptionalLidarModel(p, node, w, lidar);
   T_base_lidar = p.pose(node, w, "T_base_lidar");
   return lidar;
 }
 
-Camera parseCamera(const MetaParser& p, const YAML::Node& node, const std::string& w) {
+Camera parseCamera(const YamlFields& p, const YAML::Node& node, const std::string& w) {
   p.expectMap(node, w);
   p.checkKeys(
       node, w,
@@ -259,7 +119,7 @@ Camera parseCamera(const MetaParser& p, const YAML::Node& node, const std::strin
     try {
       cam.model = parseCameraModel(p.text(node, w, "model"));
     } catch (const std::invalid_argument& e) {
-      p.fail(MetaParser::field(w, "model") + ": " + e.what());
+      p.fail(YamlFields::field(w, "model") + ": " + e.what());
     }
     cam.distortion = p.numbers<5>(node, w, "distortion");
   }
@@ -267,7 +127,7 @@ Camera parseCamera(const MetaParser& p, const YAML::Node& node, const std::strin
   return cam;
 }
 
-SemanticClass parseClass(const MetaParser& p, const YAML::Node& node, const std::string& w) {
+SemanticClass parseClass(const YamlFields& p, const YAML::Node& node, const std::string& w) {
   p.expectMap(node, w);
   p.checkKeys(node, w, {"id", "name", "color", "dynamic", "ground"});
   SemanticClass c;
@@ -368,17 +228,8 @@ void writeMetaYaml(const fs::path& path, const DatasetInfo& info) {
 }
 
 DatasetInfo readMetaYaml(const fs::path& path) {
-  const MetaParser p(path);
-  if (!fs::exists(path)) p.fail("missing");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::ParserException& e) {
-    p.fail("YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +
-           std::to_string(e.mark.column + 1) + ": " + e.msg);
-  } catch (const YAML::Exception& e) {
-    p.fail(std::string("cannot read: ") + e.what());
-  }
+  const YamlFields p(path);
+  const YAML::Node root = loadYamlFile(path);
   if (!root.IsMap()) p.fail("expected a YAML mapping at the top level");
 
   // The version comes first: a newer file may well have keys this build does not know.
@@ -459,6 +310,30 @@ std::vector<LidarPoint> readLidarBin(const fs::path& path) {
     points[i] = {v[0], v[1], v[2], v[3]};
   }
   return points;
+}
+
+void writePointTimesBin(const fs::path& path, const std::vector<float>& times) {
+  for (size_t i = 0; i < times.size(); ++i)
+    if (!std::isfinite(times[i]))
+      throw std::invalid_argument(path.string() + ": point " + std::to_string(i) +
+                                  " has a non-finite time");
+  std::string bytes(times.size() * 4, '\0');
+  if (!times.empty()) std::memcpy(&bytes[0], times.data(), bytes.size());
+  writeBytesAtomically(path, bytes);
+}
+
+std::vector<float> readPointTimesBin(const fs::path& path) {
+  const std::string bytes = readFileBytes(path);
+  if (bytes.size() % 4 != 0)
+    throw std::runtime_error(path.string() + ": truncated (" + std::to_string(bytes.size()) +
+                             " bytes is not a multiple of 4)");
+  std::vector<float> times(bytes.size() / 4);
+  if (!times.empty()) std::memcpy(times.data(), bytes.data(), bytes.size());
+  for (size_t i = 0; i < times.size(); ++i)
+    if (!std::isfinite(times[i]))
+      throw std::runtime_error(path.string() + ": point " + std::to_string(i) +
+                               " has a non-finite time");
+  return times;
 }
 
 void writeLabelBin(const fs::path& path, const std::vector<PointLabel>& labels) {

@@ -40,6 +40,11 @@ DatasetInfo readMetaYaml(const std::filesystem::path& path);
 void writeLidarBin(const std::filesystem::path& path, const std::vector<LidarPoint>& points);
 std::vector<LidarPoint> readLidarBin(const std::filesystem::path& path);
 
+// Per-point times (seconds after the frame's timestamp) as float32, one per point of the scan:
+// lidar_times/NNNNNN.bin, present when the source had them (for deskewing).
+void writePointTimesBin(const std::filesystem::path& path, const std::vector<float>& times);
+std::vector<float> readPointTimesBin(const std::filesystem::path& path);
+
 // Per-point labels as uint32: class in the low 16 bits, instance in the high 16
 // (SemanticKITTI's .label layout).
 void writeLabelBin(const std::filesystem::path& path, const std::vector<PointLabel>& labels);

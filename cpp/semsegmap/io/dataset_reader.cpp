@@ -168,6 +168,17 @@ Frame DatasetReader::frame(size_t i) {
     checkLabelClasses(label_path, frame.point_labels, info_.classes);
   }
 
+  // Like the camera folders: lidar_times/ present means every frame has its file.
+  if (fs::is_directory(dir_ / "lidar_times")) {
+    const fs::path times_path = dir_ / "lidar_times" / frameFileName(row.index, "bin");
+    requireFile(times_path);
+    frame.point_times = readPointTimesBin(times_path);
+    if (frame.point_times.size() != frame.points.size())
+      throw std::runtime_error(
+          times_path.string() + ": " + std::to_string(frame.point_times.size()) + " times, but " +
+          lidar_path.string() + " has " + std::to_string(frame.points.size()) + " points");
+  }
+
   // A camera folder's presence says that every frame has an image in it (the writer fixes the
   // streams with the first frame), which is what makes a missing file an error.
   const std::string png = frameFileName(row.index, "png");

@@ -27,7 +27,7 @@ bool isCameraFolder(const std::string& name) {
 
 bool isFormatEntry(const std::string& name) {
   return name == "meta.yaml" || name == "frames.csv" || name == "lidar" || name == "lidar_gt" ||
-         isCameraFolder(name);
+         name == "lidar_times" || isCameraFolder(name);
 }
 
 // Rewriting a dataset must not leave the previous run's camK/ folders behind: the reader takes
@@ -69,8 +69,8 @@ std::string sizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-void checkImage(const fs::path& path, const Image& image, const Camera& cam,
-                const char* kind, int channels) {
+void checkImage(const fs::path& path, const Image& image, const Camera& cam, const char* kind,
+                int channels) {
   if (image.channels != channels)
     throw std::invalid_argument(path.string() + ": " + kind + " image of camera '" + cam.name +
                                 "' has " + std::to_string(image.channels) + " channels, expected " +
@@ -131,6 +131,15 @@ void DatasetWriter::checkFrame(const Frame& frame) const {
   } else if (!frame.point_labels.empty()) {
     reject(label_path, frame, "has point labels but DatasetInfo::has_point_labels is false");
   }
+  const fs::path times_path = dir_ / "lidar_times" / frameFileName(frame.index, "bin");
+  if (!frame.point_times.empty() && frame.point_times.size() != frame.points.size())
+    reject(times_path, frame,
+           std::to_string(frame.point_times.size()) + " point times for " +
+               std::to_string(frame.points.size()) + " points");
+  if (last_index_ && frame.point_times.empty() == has_point_times_)
+    reject(times_path, frame,
+           std::string(has_point_times_ ? "lacks" : "has") +
+               " per-point times, unlike the first frame written");
   const size_t n_cameras = info_.rig.cameras.size();
   if (!frame.cameras.empty() && frame.cameras.size() != n_cameras)
     reject(csv, frame,
@@ -181,8 +190,11 @@ void DatasetWriter::writeFiles(const Frame& frame, const std::vector<bool>& has_
     }
     camera_has_rgb_ = has_rgb;
     camera_has_label_ = has_label;
+    has_point_times_ = !frame.point_times.empty();
+    if (has_point_times_) fs::create_directories(dir_ / "lidar_times");
   }
   writeLidarBin(dir_ / "lidar" / name, frame.points);
+  if (has_point_times_) writePointTimesBin(dir_ / "lidar_times" / name, frame.point_times);
   if (info_.has_point_labels) writeLabelBin(dir_ / "lidar_gt" / name, frame.point_labels);
   for (size_t k = 0; k < n_cameras; ++k) {
     if (has_rgb[k]) writePng(cameraDir(dir_, k, false) / png, frame.cameras[k].rgb);

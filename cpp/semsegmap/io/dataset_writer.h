@@ -38,6 +38,7 @@ class DatasetWriter {
   // files and the reader can tell a missing file from a stream the dataset does not have.
   std::vector<bool> camera_has_rgb_;
   std::vector<bool> camera_has_label_;
+  bool has_point_times_ = false;  // likewise lidar_times/
 };
 
 }  // namespace semsegmap

@@ -64,6 +64,21 @@ Image readPng(const std::filesystem::path& path) {
   }
 }
 
+Image readColorImage(const std::filesystem::path& path) {
+  const std::string bytes = readFileBytes(path);
+  cv::Mat decoded;
+  try {
+    const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data()));
+    decoded = cv::imdecode(buffer, cv::IMREAD_COLOR);  // BGR, 8 bit, grey expanded
+  } catch (const cv::Exception& e) {
+    fail(path, "corrupt image (" + e.err + ")");
+  }
+  if (decoded.empty()) fail(path, "not a readable PNG or JPEG image");
+  cv::Mat rgb;
+  cv::cvtColor(decoded, rgb, cv::COLOR_BGR2RGB);
+  return fromMat(rgb);
+}
+
 void writePng(const std::filesystem::path& path, const Image& image) {
   if (image.channels != 1 && image.channels != 3)
     throw std::invalid_argument(path.string() + ": image has " + std::to_string(image.channels) +

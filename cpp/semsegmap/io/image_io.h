@@ -10,6 +10,10 @@ namespace semsegmap {
 // Reads an 8-bit PNG. RGB images come back as 3 channels in R, G, B order; single-channel
 // images as 1 channel. Throws std::runtime_error naming the file when it is missing or corrupt.
 Image readPng(const std::filesystem::path& path);
+// Reads a camera picture, PNG or JPEG, as 3-channel RGB (a grey picture is repeated into the
+// three channels, alpha dropped). Throws std::runtime_error naming the file when it is missing,
+// corrupt or not 8-bit.
+Image readColorImage(const std::filesystem::path& path);
 // Writes atomically (temporary name + rename). Throws naming the file on failure.
 void writePng(const std::filesystem::path& path, const Image& image);
 

@@ -152,8 +152,8 @@ std::vector<std::pair<size_t, std::filesystem::path>> listKittiFrames(
   return files;
 }
 
-Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam,
-                                   const KittiCalibFile& velo_to_cam, int index) {
+Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam, const KittiCalibFile& velo_to_cam,
+                            int index) {
   const std::string suffix = "_0" + std::to_string(index);
   const std::string p_key = "P_rect" + suffix;
   const std::string s_key = "S_rect" + suffix;
@@ -228,6 +228,58 @@ Frame kittiScanFrame(size_t index, double timestamp_s, const std::filesystem::pa
 void throwFrameOutOfRange(const std::string& dataset, size_t index, size_t frames) {
   throw std::out_of_range(dataset + ": frame " + std::to_string(index) + " out of range (" +
                           std::to_string(frames) + " frames)");
+}
+
+// One line of numbers per entry; blank lines are skipped, but every other line counts so that
+// line n stays frame n.
+std::vector<std::vector<double>> readNumberLines(const std::filesystem::path& path,
+                                                 size_t per_line) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open");
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  for (int line_no = 1; std::getline(in, line); ++line_no) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::string where = path.string() + ": line " + std::to_string(line_no);
+    std::vector<double> v;
+    try {
+      v = parseNumbers(line);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(where + ": " + e.what());
+    }
+    if (v.size() != per_line)
+      throw std::runtime_error(where + ": expected " + std::to_string(per_line) +
+                               " values, found " + std::to_string(v.size()));
+    rows.push_back(std::move(v));
+  }
+  return rows;
+}
+
+std::vector<Pose> readKittiPoses(const std::filesystem::path& path) {
+  std::vector<Pose> poses;
+  for (const auto& row : readNumberLines(path, 12)) {
+    Eigen::Matrix3d R;
+    R << row[0], row[1], row[2], row[4], row[5], row[6], row[8], row[9], row[10];
+    checkRotation(R, path.string() + ": pose " + std::to_string(poses.size() + 1));
+    Pose T = Pose::Identity();
+    T.linear() = R;
+    T.translation() = Eigen::Vector3d(row[3], row[7], row[11]);
+    poses.push_back(T);
+  }
+  return poses;
+}
+
+std::vector<Pose> kittiLidarPoses(const std::vector<Pose>& camera0_poses, const Pose& Tr) {
+  const Pose Tr_inv = Tr.inverse(Eigen::Affine);
+  std::vector<Pose> lidar;
+  lidar.reserve(camera0_poses.size());
+  for (const Pose& T_world_cam : camera0_poses) {
+    Pose T_world_lidar = Tr_inv * T_world_cam * Tr;
+    // The files print 7 digits; a clean rotation keeps Pose::inverse() exact downstream.
+    T_world_lidar.linear() = nearestRotation(T_world_lidar.linear());
+    lidar.push_back(T_world_lidar);
+  }
+  return lidar;
 }
 
 }  // namespace semsegmap

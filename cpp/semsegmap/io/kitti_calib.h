@@ -74,6 +74,19 @@ double kittiScanTime(const std::vector<double>* times, const std::filesystem::pa
 // A frame of scan `path` (KITTI's .bin, read with readLidarBin) and nothing else yet.
 Frame kittiScanFrame(size_t index, double timestamp_s, const std::filesystem::path& path);
 // std::out_of_range "<dataset>: frame <index> out of range (<frames> frames)".
+// One line of `per_line` numbers per entry (times.txt, poses.txt); blank lines are skipped but
+// counted, so that the line numbers in errors are the file's.
+std::vector<std::vector<double>> readNumberLines(const std::filesystem::path& path,
+                                                 size_t per_line);
+
+// A KITTI pose file: per line the 12 numbers of a row-major 3x4 [R | t], each R a rotation
+// up to the printed digits. Throws std::runtime_error "<file>:<line>: ..." otherwise.
+std::vector<Pose> readKittiPoses(const std::filesystem::path& path);
+
+// KITTI odometry's poses are of camera 0; calib.txt's Tr (Velodyne -> camera 0) turns them into
+// LiDAR poses in the first LiDAR frame: T_world_lidar = Tr^-1 * T_world_cam0 * Tr.
+std::vector<Pose> kittiLidarPoses(const std::vector<Pose>& camera0_poses, const Pose& Tr);
+
 [[noreturn]] void throwFrameOutOfRange(const std::string& dataset, size_t index, size_t frames);
 
 // KITTI raw's rectified camera `index` (2 = left color) as our Camera, such that
@@ -81,8 +94,8 @@ Frame kittiScanFrame(size_t index, double timestamp_s, const std::filesystem::pa
 // P_rect_0i * R_rect_00 * [R|T]_velo_to_cam * X for every LiDAR point X. P_rect_0i = K [I | K^-1 p]
 // is split into the intrinsics K and a translation K^-1 p (the stereo baseline), so
 // T_camera_lidar = Translation(K^-1 p) * R_rect_00 * T_cam0_velo. Size from S_rect_0i.
-Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam,
-                                   const KittiCalibFile& velo_to_cam, int index);
+Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam, const KittiCalibFile& velo_to_cam,
+                            int index);
 
 // The Velodyne HDL-64E of KITTI (datasheet values at 10 Hz), for rigs of real KITTI data.
 LidarModel velodyneHdl64e();

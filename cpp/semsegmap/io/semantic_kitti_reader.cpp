@@ -11,34 +11,6 @@
 
 namespace semsegmap {
 namespace fs = std::filesystem;
-namespace {
-
-// One line of numbers per entry; blank lines are skipped, but every other line counts so that
-// line n stays frame n.
-std::vector<std::vector<double>> readNumberLines(const fs::path& path, size_t per_line) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open");
-  std::vector<std::vector<double>> rows;
-  std::string line;
-  for (int line_no = 1; std::getline(in, line); ++line_no) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const std::string where = path.string() + ": line " + std::to_string(line_no);
-    std::vector<double> v;
-    try {
-      v = parseNumbers(line);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(where + ": " + e.what());
-    }
-    if (v.size() != per_line)
-      throw std::runtime_error(where + ": expected " + std::to_string(per_line) +
-                               " values, found " + std::to_string(v.size()));
-    rows.push_back(std::move(v));
-  }
-  return rows;
-}
-
-}  // namespace
-
 const std::vector<SemanticKittiClass>& semanticKittiClasses() {
   static const std::vector<SemanticKittiClass> table = {
       {0, "unlabeled", cls::kUnknown},
@@ -114,21 +86,7 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
     // SemanticKITTI's poses are of camera 0; Tr moves them onto the Velodyne.
     const KittiCalibFile calib(dir_ / "calib.txt");
     const Pose Tr = calib.transform3x4("Tr");
-    const Pose Tr_inv = Tr.inverse(Eigen::Affine);
-    int line_no = 0;
-    for (const auto& row : readNumberLines(poses_path, 12)) {
-      ++line_no;
-      Eigen::Matrix3d R;
-      R << row[0], row[1], row[2], row[4], row[5], row[6], row[8], row[9], row[10];
-      checkRotation(R, poses_path.string() + ": pose " + std::to_string(line_no));
-      Pose T_world_cam = Pose::Identity();
-      T_world_cam.linear() = R;
-      T_world_cam.translation() = Eigen::Vector3d(row[3], row[7], row[11]);
-      Pose T_world_lidar = Tr_inv * T_world_cam * Tr;
-      // The files print 7 digits; a clean rotation keeps Pose::inverse() exact downstream.
-      T_world_lidar.linear() = nearestRotation(T_world_lidar.linear());
-      poses.push_back(T_world_lidar);
-    }
+    poses = kittiLidarPoses(readKittiPoses(poses_path), Tr);
   }
 
   for (const auto& [number, scan] : scans) {

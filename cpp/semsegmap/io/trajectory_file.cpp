@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/io/kitti_calib.h"
 
 namespace semsegmap {
 
@@ -108,6 +109,40 @@ std::vector<StampedPose> readTum(const std::filesystem::path& path) {
     poses.push_back(parseTumLine(line, path.string() + ":" + std::to_string(line_number) + ": "));
   }
   return poses;
+}
+
+PoseFile readPoseFile(const std::filesystem::path& path) {
+  const std::string bytes = readFileBytes(path);
+  size_t start = 0;
+  size_t fields = 0;
+  while (start < bytes.size() && fields == 0) {
+    size_t end = bytes.find('\n', start);
+    if (end == std::string::npos) end = bytes.size();
+    std::string_view line(bytes.data() + start, end - start);
+    start = end + 1;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first != std::string_view::npos && line[first] != '#') fields = splitFields(line).size();
+  }
+  PoseFile file;
+  if (fields == 8) {
+    file.poses = readTum(path);
+    if (file.poses.empty()) throw std::runtime_error(path.string() + ": no poses");
+    for (size_t i = 1; i < file.poses.size(); ++i)
+      if (!(file.poses[i].timestamp_s > file.poses[i - 1].timestamp_s))
+        throw std::runtime_error(path.string() + ": pose " + std::to_string(i + 1) +
+                                 ": the times do not increase");
+    return file;
+  }
+  if (fields != 12)
+    throw std::runtime_error(path.string() +
+                             ": expected 8 numbers per line (TUM: time x y z qx "
+                             "qy qz qw) or 12 (KITTI: a row-major 3x4 matrix), got " +
+                             std::to_string(fields));
+  file.timestamped = false;
+  const std::vector<Pose> poses = readKittiPoses(path);
+  for (size_t i = 0; i < poses.size(); ++i)
+    file.poses.push_back({static_cast<double>(i), poses[i]});
+  return file;
 }
 
 }  // namespace semsegmap

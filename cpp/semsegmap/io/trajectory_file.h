@@ -20,4 +20,13 @@ void writeKitti(const std::filesystem::path& path, const std::vector<StampedPose
 // is not within 1e-3 of 1 (those close to unit are normalised: files printed with few decimals).
 std::vector<StampedPose> readTum(const std::filesystem::path& path);
 
+// A pose file in either format, told apart by the number of fields on its first pose line
+// (8: TUM, 12: KITTI). KITTI files have no times: their poses are stamped with their line
+// index (0, 1, ...), and pair with frames by index.
+struct PoseFile {
+  bool timestamped = true;  // TUM
+  std::vector<StampedPose> poses;
+};
+PoseFile readPoseFile(const std::filesystem::path& path);
+
 }  // namespace semsegmap

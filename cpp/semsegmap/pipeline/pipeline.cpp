@@ -38,9 +38,10 @@ Pipeline::Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSo
   // Refused up front: without odometry every T_odom_base is the identity, and a run on them
   // would stack all scans in one place and still exit 0.
   if (poses == PoseSource::kOdometry && !info.has_odometry)
-    throw std::runtime_error("dataset " + info.name +
-                             " has no odometry: give --odometry FILE (TUM or KITTI poses)" +
-                             (info.has_ground_truth_poses ? ", or --poses gt" : ""));
+    throw std::runtime_error(
+        "dataset " + info.name +
+        " has no odometry: give --odometry FILE (TUM or KITTI poses) or --odometry lidar" +
+        (info.has_ground_truth_poses ? ", or --poses gt" : ""));
 }
 
 void Pipeline::describe(const std::vector<SegmentId>& ids, size_t frame_index) {

@@ -30,9 +30,8 @@ uint8_t toByte(float linear) {
 
 }  // namespace
 
-CameraRender renderCamera(const RayScene& scene, const Camera& camera,
-                          const Pose& T_world_camera, const Lighting& lighting, uint64_t noise_seed,
-                          bool with_depth) {
+CameraRender renderCamera(const RayScene& scene, const Camera& camera, const Pose& T_world_camera,
+                          const Lighting& lighting, uint64_t noise_seed, bool with_depth) {
   CameraRender out;
   out.rgb = Image(camera.width, camera.height, 3);
   out.label = Image(camera.width, camera.height, 1);

@@ -19,8 +19,7 @@ struct CameraRender {
   std::vector<float> depth;  // z in the camera frame, 0 where the sky is seen; only on request
 };
 
-CameraRender renderCamera(const RayScene& scene, const Camera& camera,
-                          const Pose& T_world_camera, const Lighting& lighting, uint64_t noise_seed,
-                          bool with_depth = false);
+CameraRender renderCamera(const RayScene& scene, const Camera& camera, const Pose& T_world_camera,
+                          const Lighting& lighting, uint64_t noise_seed, bool with_depth = false);
 
 }  // namespace semsegmap::sim

@@ -2,24 +2,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "semsegmap/core/random.h"
 
 namespace semsegmap::sim {
 
-LidarScan simulateLidar(const RayScene& scene, const LidarModel& lidar, const Pose& T_world_lidar,
-                        uint64_t noise_seed) {
+namespace {
+
+// Every beam of the scan; column c is cast from poses[c], or from poses[0] when there is one
+// pose (a scan without motion, computed exactly as before sweeps existed). With column_times,
+// each point gets its column's time.
+LidarScan castBeams(const RayScene& scene, const LidarModel& lidar, const std::vector<Pose>& poses,
+                    const std::vector<float>* column_times, uint64_t noise_seed) {
   const int n = lidar.columns * lidar.rows;
   // Every beam writes its own slot; compacting afterwards in beam order keeps the output
   // independent of thread scheduling.
   std::vector<LidarPoint> slots(n);
   std::vector<PointLabel> slot_labels(n);
   std::vector<uint8_t> valid(n, 0);
-  const Eigen::Matrix3f R = T_world_lidar.linear().cast<float>();
-  const Eigen::Vector3f origin = T_world_lidar.translation().cast<float>();
 
 #pragma omp parallel for schedule(dynamic, 16)
   for (int col = 0; col < lidar.columns; ++col) {
+    const Pose& T_world_lidar = poses[poses.size() == 1 ? 0 : static_cast<size_t>(col)];
+    const Eigen::Matrix3f R = T_world_lidar.linear().cast<float>();
+    const Eigen::Vector3f origin = T_world_lidar.translation().cast<float>();
     for (int row = 0; row < lidar.rows; ++row) {
       const int k = col * lidar.rows + row;
       const uint64_t h = hashKeys(noise_seed, static_cast<uint64_t>(k));
@@ -46,8 +54,27 @@ LidarScan simulateLidar(const RayScene& scene, const LidarModel& lidar, const Po
     if (!valid[k]) continue;
     scan.points.push_back(slots[k]);
     scan.labels.push_back(slot_labels[k]);
+    if (column_times) scan.times.push_back((*column_times)[static_cast<size_t>(k / lidar.rows)]);
   }
   return scan;
+}
+
+}  // namespace
+
+LidarScan simulateLidar(const RayScene& scene, const LidarModel& lidar, const Pose& T_world_lidar,
+                        uint64_t noise_seed) {
+  return castBeams(scene, lidar, {T_world_lidar}, nullptr, noise_seed);
+}
+
+LidarScan simulateLidarSweep(const RayScene& scene, const LidarModel& lidar,
+                             const std::vector<Pose>& T_world_lidar_columns,
+                             const std::vector<float>& column_times, uint64_t noise_seed) {
+  const size_t columns = static_cast<size_t>(lidar.columns);
+  if (T_world_lidar_columns.size() != columns || column_times.size() != columns)
+    throw std::invalid_argument("simulateLidarSweep: " + std::to_string(columns) + " columns but " +
+                                std::to_string(T_world_lidar_columns.size()) + " poses and " +
+                                std::to_string(column_times.size()) + " times");
+  return castBeams(scene, lidar, T_world_lidar_columns, &column_times, noise_seed);
 }
 
 }  // namespace semsegmap::sim

@@ -1,5 +1,9 @@
 #include "semsegmap/sim/simulator.h"
 
+#include <algorithm>
+
+#include <Eigen/Geometry>
+
 #include "semsegmap/core/random.h"
 #include "semsegmap/sim/camera_sim.h"
 #include "semsegmap/sim/lidar_sim.h"
@@ -36,6 +40,41 @@ size_t Simulator::size() const {
   return config_.max_frames > 0 ? std::min(n, config_.max_frames) : n;
 }
 
+namespace {
+
+// The base's pose a time t after frame `index`, at the motion between it and the next frame (the
+// one before it for the last frame): constant velocity over one frame, as the vehicle drives.
+Pose baseAt(const Trajectory& trajectory, size_t index, double t) {
+  const size_t n = trajectory.T_world_base.size();
+  const size_t a = index + 1 < n ? index : (index > 0 ? index - 1 : index);
+  const size_t b = std::min(a + 1, n - 1);
+  const double period = trajectory.timestamps_s[b] - trajectory.timestamps_s[a];
+  if (a == b || !(period > 0)) return trajectory.T_world_base[index];
+  const Pose delta = trajectory.T_world_base[a].inverse() * trajectory.T_world_base[b];
+  const double s = (trajectory.timestamps_s[index] + t - trajectory.timestamps_s[a]) / period;
+  const Eigen::AngleAxisd rotation(delta.linear());
+  Pose step = Pose::Identity();
+  step.linear() = Eigen::AngleAxisd(rotation.angle() * s, rotation.axis()).toRotationMatrix();
+  step.translation() = delta.translation() * s;
+  return trajectory.T_world_base[a] * step;
+}
+
+}  // namespace
+
+// The moving agents stay where they are at the frame's time during the sweep: only the
+// vehicle's own motion distorts the scan.
+LidarScan Simulator::sweepLidar(size_t index, uint64_t seed) const {
+  const LidarModel& lidar = config_.rig.lidar;
+  const double sweep_s = lidar.hfov_deg / 360.0 / config_.rig.rate_hz;
+  std::vector<Pose> poses(static_cast<size_t>(lidar.columns));
+  std::vector<float> times(poses.size());
+  for (size_t c = 0; c < poses.size(); ++c) {
+    times[c] = static_cast<float>(sweep_s * static_cast<double>(c) / lidar.columns);
+    poses[c] = baseAt(trajectory_, index, times[c]) * config_.rig.T_base_lidar;
+  }
+  return simulateLidarSweep(*scene_, lidar, poses, times, seed);
+}
+
 Frame Simulator::frame(size_t index) {
   if (index >= size())
     throw std::out_of_range("simulator: frame " + std::to_string(index) + " of " +
@@ -51,9 +90,12 @@ Frame Simulator::frame(size_t index) {
   const uint64_t seed =
       hashKeys(config_.world.seed, traffic_seed_, static_cast<uint64_t>(config_.run), index);
   const Pose T_world_lidar = T_world_base * config_.rig.T_base_lidar;
-  LidarScan scan = simulateLidar(*scene_, config_.rig.lidar, T_world_lidar, seed);
+  LidarScan scan = config_.lidar_sweep
+                       ? sweepLidar(index, seed)
+                       : simulateLidar(*scene_, config_.rig.lidar, T_world_lidar, seed);
   f.points = std::move(scan.points);
   f.point_labels = std::move(scan.labels);
+  f.point_times = std::move(scan.times);
   for (size_t c = 0; c < info_.rig.cameras.size(); ++c) {
     const Camera& cam = info_.rig.cameras[c];
     CameraRender r = renderCamera(*scene_, cam, T_world_lidar * cam.T_camera_lidar.inverse(),

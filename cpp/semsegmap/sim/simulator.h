@@ -8,6 +8,7 @@
 #include <string>
 
 #include "semsegmap/core/frame_source.h"
+#include "semsegmap/sim/lidar_sim.h"
 #include "semsegmap/sim/lighting.h"
 #include "semsegmap/sim/ray_scene.h"
 #include "semsegmap/sim/trajectory.h"
@@ -25,6 +26,10 @@ struct SimConfig {
   TrajectoryConfig trajectory;
   OdometryNoise odometry;
   bool render_cameras = true;
+  // Motion distortion: the LiDAR sweeps its columns over the frame period (hfov / 360 of it,
+  // one turn per frame) while the vehicle drives on, each point in the LiDAR frame of its own
+  // time, Frame::point_times filled. Off: every column at the frame's pose, as before.
+  bool lidar_sweep = false;
   double agent_clearance_m = 6.0;
 };
 
@@ -44,6 +49,8 @@ class Simulator : public FrameSource {
   const RayScene& scene() const { return *scene_; }
 
  private:
+  LidarScan sweepLidar(size_t index, uint64_t seed) const;
+
   SimConfig config_;
   uint64_t traffic_seed_;
   std::unique_ptr<World> world_;

@@ -92,6 +92,13 @@ Image drawEnrichOverlay(const Image& rgb, const Camera& camera, const EnrichedCl
       x += w;
     }
   }
+  if (style.max_width > 0 && canvas.cols > style.max_width) {
+    // Shrunk after drawing: the dots keep their places on the picture, the file gets small.
+    cv::Mat small;
+    const double f = static_cast<double>(style.max_width) / canvas.cols;
+    cv::resize(canvas, small, cv::Size(), f, f, cv::INTER_AREA);
+    return fromBgr(small);
+  }
   return fromBgr(canvas);
 }
 

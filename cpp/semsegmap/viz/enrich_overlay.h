@@ -21,6 +21,7 @@ struct EnrichOverlayStyle {
   DotColour colour = DotColour::kClass;
   int dot_radius_px = 1;              // 0: single pixels
   double near_m = 3.0, far_m = 60.0;  // depth colour scale (logarithmic between the two)
+  int max_width = 0;                  // > 0: a wider picture is shrunk to this width once drawn
 };
 
 // `rgb` is `camera`'s image; every point of `cloud` in front of the camera and inside the image

@@ -1,0 +1,62 @@
+// semsegmap odometry: LiDAR odometry over a dataset, from its scans alone; writes the trajectory
+// (TUM and KITTI formats), summary.json and, with ground truth, the KITTI relative error, the ATE
+// and trajectory.png.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "cli_args.h"
+#include "dataset_args.h"
+#include "progress.h"
+#include "semsegmap/eval/odometry_run.h"
+#include "semsegmap/io/config.h"
+
+namespace semsegmap::app {
+
+namespace {
+
+int runOdometryCommand(const CliArgs& a) {
+  const OdometryConfig config =
+      a.has("config") ? loadOdometryConfig(a.get("config")) : OdometryConfig{};
+  const std::filesystem::path out = a.get("out");
+  auto source = openDatasetArg(a);
+  Progress progress("odometry", 0);
+  const OdometryRun run =
+      runLidarOdometry(*source, config, a.frameLimit(),
+                       [&](size_t done, size_t total) { progress.update(done, total); });
+  writeOdometryFiles(out, run);
+  const std::optional<OdometryErrors> errors = odometryErrors(run);
+  size_t predicted = 0;
+  for (const OdometryResult& r : run.frames) predicted += r.usedPrediction();
+  std::printf("frames %zu  %.1f ms/frame  prediction used %zu\n", run.frames.size(),
+              run.frames.empty() ? 0.0 : 1e3 * run.seconds / run.frames.size(), predicted);
+  if (errors)
+    std::printf(
+        "KITTI relative error %.2f %%  %.3f deg/100 m (%zu segments)  ATE %.2f m "
+        "(aligned %.2f m)\n",
+        errors->kitti.translation_percent, errors->kitti.rotation_deg_per_100m,
+        errors->kitti.segments.size(), errors->ate.rmse_m, errors->ate_aligned.rmse_m);
+  std::cout << "wrote " << (out / "trajectory_tum.txt").string()
+            << ", trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << "\n";
+  return 0;
+}
+
+}  // namespace
+
+const CommandSpec& odometryCommand() {
+  static const CommandSpec command{
+      "odometry",
+      "LiDAR odometry from the scans alone -> trajectories, summary.json, trajectory.png",
+      datasetOptions("the run whose scans to register",
+                     {
+                         {"out", Value::kText, "DIR", "", "output folder", kRequired},
+                         {"config", Value::kText, "FILE", "",
+                          "a config whose odometry: section to use (default: built-in defaults)"},
+                         maxFramesOption(),
+                     },
+                     /*odometry_option=*/false),
+      kDatasetNotes, runOdometryCommand};
+  return command;
+}
+
+}  // namespace semsegmap::app

@@ -1,0 +1,48 @@
+#include "dataset_args.h"
+
+#include <algorithm>
+
+#include "semsegmap/datasets/open_dataset.h"
+#include "semsegmap/io/config.h"
+
+namespace semsegmap::app {
+
+std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<OptionSpec> more,
+                                       bool odometry_option) {
+  std::vector<OptionSpec> options = {
+      {"dataset", Value::kText, "SPEC", "", help, kRequired},
+      {"rig", Value::kText, "FILE", "", "rig file of a folder: dataset (docs/rig-format.md)"},
+      {"odometry", Value::kText, "FILE|lidar", "",
+       "odometry poses of the base, TUM or KITTI format, or lidar: LiDAR odometry on the scans "
+       "(replaces the dataset's)"},
+      {"ground-truth", Value::kText, "FILE", "",
+       "ground-truth poses of the base, TUM or KITTI format (replaces the dataset's)"},
+      {"kitti-calib", Value::kText, "FILE", "",
+       "KITTI calib.txt whose Tr turns KITTI camera-0 poses into LiDAR poses"},
+  };
+  if (!odometry_option)
+    options.erase(std::remove_if(options.begin(), options.end(),
+                                 [](const OptionSpec& o) { return o.name == "odometry"; }),
+                  options.end());
+  options.insert(options.end(), more.begin(), more.end());
+  return options;
+}
+
+std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a) {
+  DatasetOptions options;
+  if (a.has("rig")) options.rig = a.get("rig");
+  const auto& declared = a.command().options;
+  auto declares = [&](const char* name) {
+    return std::any_of(declared.begin(), declared.end(),
+                       [&](const OptionSpec& o) { return o.name == name; });
+  };
+  if (declares("odometry") && a.has("odometry")) options.odometry = a.get("odometry");
+  // LiDAR odometry takes its settings from the odometry section of the command's config.
+  if (options.odometry == "lidar" && declares("config") && a.has("config"))
+    options.lidar_odometry = loadOdometryConfig(a.get("config"));
+  if (a.has("ground-truth")) options.ground_truth = a.get("ground-truth");
+  if (a.has("kitti-calib")) options.kitti_calib = a.get("kitti-calib");
+  return openDataset(a.get("dataset"), options);
+}
+
+}  // namespace semsegmap::app

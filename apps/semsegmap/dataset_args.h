@@ -1,0 +1,22 @@
+// The --dataset SPEC of every command that reads data, with the options that complete a robot's
+// own recording: its rig file and the poses it lacks.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli_args.h"
+#include "semsegmap/core/frame_source.h"
+
+namespace semsegmap::app {
+
+// --dataset (required, described by `help`), --rig, --odometry (unless the command makes the
+// odometry itself), --ground-truth, --kitti-calib, followed by `more`.
+std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<OptionSpec> more,
+                                       bool odometry_option = true);
+
+// openDataset() with those options.
+std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a);
+
+}  // namespace semsegmap::app

@@ -1,0 +1,109 @@
+#include "semsegmap/datasets/pose_files.h"
+
+#include <iostream>
+#include <optional>
+#include <stdexcept>
+#include <vector>
+
+#include "semsegmap/graph/trajectory.h"
+#include "semsegmap/io/kitti_calib.h"
+#include "semsegmap/io/trajectory_file.h"
+
+namespace semsegmap {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// KITTI poses of camera 0 become LiDAR poses when a calibration says how (see PoseFileOptions).
+void applyKittiCalib(const fs::path& poses_path, const fs::path& explicit_calib,
+                     const Pose& T_base_lidar, std::vector<StampedPose>& poses) {
+  fs::path calib = explicit_calib;
+  if (calib.empty()) {
+    const fs::path beside = poses_path.parent_path() / "calib.txt";
+    if (!fs::exists(beside) || !KittiCalibFile(beside).has("Tr")) return;
+    calib = beside;
+    std::cerr << "note: " << poses_path.string() << ": KITTI camera-0 poses, turned into LiDAR "
+              << "poses with Tr from " << calib.string() << " (--kitti-calib FILE to choose)\n";
+  }
+  const Pose Tr = KittiCalibFile(calib).transform3x4("Tr");
+  std::vector<Pose> camera0;
+  for (const StampedPose& p : poses) camera0.push_back(p.T);
+  const std::vector<Pose> lidar = kittiLidarPoses(camera0, Tr);
+  // The files hold base poses: the LiDAR poses moved onto the base the rig mounts them on.
+  const Pose T_lidar_base = T_base_lidar.inverse();
+  for (size_t i = 0; i < poses.size(); ++i) poses[i].T = T_base_lidar * lidar[i] * T_lidar_base;
+}
+
+// Per frame of the source, its pose from the file, or nothing.
+std::vector<std::optional<Pose>> posesPerFrame(FrameSource& source, const fs::path& path,
+                                               const PoseFileOptions& options) {
+  PoseFile file = readPoseFile(path);
+  std::vector<std::optional<Pose>> per_frame(source.size());
+  if (!file.timestamped) {
+    applyKittiCalib(path, options.kitti_calib, source.info().rig.T_base_lidar, file.poses);
+    if (file.poses.size() < source.size())
+      throw std::runtime_error(path.string() + ": " + std::to_string(file.poses.size()) +
+                               " KITTI poses for " + std::to_string(source.size()) +
+                               " scans (line i is the pose of scan i)");
+    for (size_t i = 0; i < source.size(); ++i) per_frame[i] = file.poses[i].T;
+    return per_frame;
+  }
+  for (size_t i = 0; i < source.size(); ++i)
+    per_frame[i] = poseAt(file.poses, source.frameTime(i), options.max_gap_s);
+  return per_frame;
+}
+
+class PosedSource : public FrameSource {
+ public:
+  PosedSource(std::unique_ptr<FrameSource> source, const PoseFileOptions& options)
+      : source_(std::move(source)), info_(source_->info()) {
+    std::vector<std::optional<Pose>> odom, gt;
+    if (!options.odometry.empty()) odom = posesPerFrame(*source_, options.odometry, options);
+    if (!options.ground_truth.empty()) gt = posesPerFrame(*source_, options.ground_truth, options);
+    for (size_t i = 0; i < source_->size(); ++i) {
+      if ((!odom.empty() && !odom[i]) || (!gt.empty() && !gt[i])) continue;
+      kept_.push_back(
+          {i, odom.empty() ? std::nullopt : odom[i], gt.empty() ? std::nullopt : gt[i]});
+    }
+    const fs::path& named = !options.odometry.empty() ? options.odometry : options.ground_truth;
+    if (kept_.empty())
+      throw std::runtime_error(named.string() + ": no scan of " + info_.name +
+                               " lies within the poses' time span");
+    if (kept_.size() < source_->size())
+      std::cerr << "note: " << source_->size() - kept_.size() << " of " << source_->size()
+                << " scans lie outside the poses' time span or in a gap and are left out\n";
+    info_.has_odometry |= !odom.empty();
+    info_.has_ground_truth_poses |= !gt.empty();
+  }
+  const DatasetInfo& info() const override { return info_; }
+  size_t size() const override { return kept_.size(); }
+  double frameTime(size_t index) override { return source_->frameTime(kept_.at(index).source); }
+  Frame frame(size_t index) override {
+    const Kept& k = kept_.at(index);
+    Frame f = source_->frame(k.source);
+    f.index = index;
+    if (k.odom) f.T_odom_base = *k.odom;
+    if (k.gt) f.T_world_base = *k.gt;
+    return f;
+  }
+
+ private:
+  struct Kept {
+    size_t source;
+    std::optional<Pose> odom, gt;
+  };
+  std::unique_ptr<FrameSource> source_;
+  DatasetInfo info_;
+  std::vector<Kept> kept_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> withPoseFiles(std::unique_ptr<FrameSource> source,
+                                           const PoseFileOptions& options) {
+  if (options.odometry.empty() && options.ground_truth.empty()) return source;
+  return std::make_unique<PosedSource>(std::move(source), options);
+}
+
+}  // namespace semsegmap

@@ -1,0 +1,558 @@
+// A robot's own data in: rig files, lens models, point cloud files of any layout, folders of
+// scans and pictures, pose files. Fixtures are written by the tests; the real samples in
+// ../shared/data (KITTI 00 as PCD, the PJLab rig) are read when present.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <random>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/sensor_rig.h"
+#include "semsegmap/datasets/open_dataset.h"
+#include "semsegmap/enrich/enricher.h"
+#include "semsegmap/io/dataset_format.h"
+#include "semsegmap/io/dataset_writer.h"
+#include "semsegmap/io/folder_reader.h"
+#include "semsegmap/io/image_io.h"
+#include "semsegmap/io/kitti_calib.h"
+#include "semsegmap/io/point_cloud_file.h"
+#include "semsegmap/io/rig_file.h"
+#include "semsegmap/io/trajectory_file.h"
+#include "semsegmap/pipeline/pipeline.h"
+#include "temp_dir.h"
+
+#if SEMSEGMAP_WITH_PCL
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_types.h>
+#endif
+
+namespace fs = std::filesystem;
+using namespace semsegmap;
+using semsegmap::test_support::TempDir;
+
+namespace {
+
+const fs::path kShared = SEMSEGMAP_SHARED_DATA;
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path) << text;
+}
+
+const char* const kRig = R"(rig_format_version: 1
+name: test-rig
+rate_hz: 10
+lidar:
+  folder: scans
+  T_lidar_base:
+    translation: [0, 0, -1.5]
+    quaternion_wxyz: [1, 0, 0, 0]
+cameras:
+  - name: front
+    width: 64
+    height: 48
+    fx: 40
+    fy: 40
+    cx: 32
+    cy: 24
+    model: radtan
+    distortion: [-0.1, 0.01, 0.001, -0.002]
+    T_lidar_camera:
+      translation: [0.2, 0, -0.1]
+      quaternion_xyzw: [-0.5, 0.5, -0.5, 0.5]
+)";
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+// Lens models against OpenCV's own projection.
+
+TEST(LensModel, RadialTangentialMatchesOpenCv) {
+  Camera cam;
+  cam.model = CameraModel::kRadialTangential;
+  cam.distortion = {-0.28, 0.07, 0.0012, -0.0008, 0.01};
+  const cv::Matx33d K(cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+  const std::vector<double> d(cam.distortion.begin(), cam.distortion.end());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> lateral(-0.8, 0.8);
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d p(lateral(rng), lateral(rng), 1.0);
+    std::vector<cv::Point2d> uv;
+    cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, cv::Vec3d(0, 0, 0),
+                      cv::Vec3d(0, 0, 0), K, d, uv);
+    const auto ours = cam.project(p);
+    ASSERT_TRUE(ours.has_value());
+    EXPECT_NEAR(ours->x(), uv[0].x, 1e-9);
+    EXPECT_NEAR(ours->y(), uv[0].y, 1e-9);
+    // And back: the pixel's ray is the point's direction.
+    EXPECT_LT((cam.pixelRay(ours->x(), ours->y()) - p.normalized()).norm(), 1e-7);
+  }
+}
+
+TEST(LensModel, EquidistantMatchesOpenCvFisheye) {
+  Camera cam;
+  cam.model = CameraModel::kEquidistant;
+  cam.distortion = {0.05, -0.01, 0.002, -0.0003, 0.0};
+  const cv::Matx33d K(cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+  const cv::Vec4d d(cam.distortion[0], cam.distortion[1], cam.distortion[2], cam.distortion[3]);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> lateral(-2.5, 2.5);  // up to ~74 degrees off axis
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d p(lateral(rng), lateral(rng), 1.0);
+    std::vector<cv::Point2d> uv;
+    cv::fisheye::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, uv,
+                               cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, d);
+    const auto ours = cam.project(p);
+    ASSERT_TRUE(ours.has_value());
+    EXPECT_NEAR(ours->x(), uv[0].x, 1e-7);
+    EXPECT_NEAR(ours->y(), uv[0].y, 1e-7);
+    EXPECT_LT((cam.pixelRay(ours->x(), ours->y()) - p.normalized()).norm(), 1e-7);
+  }
+}
+
+TEST(LensModel, RefusesWhereThePolynomialFoldsBack) {
+  Camera cam;
+  cam.model = CameraModel::kRadialTangential;
+  cam.distortion = {-0.5, 0.0, 0.0, 0.0, 0.0};  // r (1 - 0.5 r^2) turns at r = 0.816
+  EXPECT_TRUE(cam.project({0.5, 0.0, 1.0}).has_value());
+  // Far off axis the polynomial comes back towards the centre: that pixel would be wrong.
+  EXPECT_FALSE(cam.project({1.5, 0.0, 1.0}).has_value());
+  EXPECT_FALSE(cam.project({0.0, 0.0, -1.0}).has_value());  // behind
+}
+
+TEST(LensModel, RigValidationNamesTheCamera) {
+  SensorRig rig;
+  Camera cam;
+  cam.name = "left";
+  cam.distortion[0] = 0.1;  // pinhole with coefficients
+  rig.cameras = {cam};
+  EXPECT_NE(errorOf([&] { rig.validate(); }).find("camera 'left'"), std::string::npos);
+  rig.cameras[0].model = CameraModel::kRadialTangential;
+  EXPECT_NO_THROW(rig.validate());
+  rig.cameras[0].distortion[1] = std::nan("");
+  EXPECT_NE(errorOf([&] { rig.validate(); }).find("finite"), std::string::npos);
+}
+
+// ------------------------------------------------------------------------------------------
+// Rig files.
+
+TEST(RigFile, ReadsBothDirectionsAndLensModels) {
+  TempDir tmp;
+  writeText(tmp.path() / "rig.yaml", kRig);
+  const RigFile rig = readRigFile(tmp.path() / "rig.yaml");
+  EXPECT_EQ(rig.name, "test-rig");
+  EXPECT_FALSE(rig.base_is_lidar);
+  // T_lidar_base was given: the base is 1.5 m below the LiDAR.
+  EXPECT_NEAR(rig.rig.T_base_lidar.translation().z(), 1.5, 1e-12);
+  ASSERT_EQ(rig.rig.cameras.size(), 1u);
+  const Camera& cam = rig.rig.cameras[0];
+  EXPECT_EQ(cam.model, CameraModel::kRadialTangential);
+  EXPECT_DOUBLE_EQ(cam.distortion[3], -0.002);
+  EXPECT_DOUBLE_EQ(cam.distortion[4], 0.0);
+  // T_lidar_camera was given: the camera looks along the LiDAR's +x, so a point 10 m ahead is
+  // on its optical axis, 10 m - 0.2 m away.
+  const Eigen::Vector3d p = cam.T_camera_lidar * Eigen::Vector3d(10.0, 0.0, -0.1);
+  EXPECT_NEAR(p.z(), 9.8, 1e-9);
+  EXPECT_NEAR(p.x(), 0.0, 1e-9);
+  EXPECT_NEAR(p.y(), 0.0, 1e-9);
+  EXPECT_EQ(rig.lidar_folder, "scans");
+  EXPECT_EQ(rig.camera_folders[0], "front");  // its name by default
+}
+
+TEST(RigFile, MatrixAndKFormsEqualTheOthers) {
+  TempDir tmp;
+  writeText(tmp.path() / "rig.yaml", R"(rig_format_version: 1
+cameras:
+  - name: c
+    width: 64
+    height: 48
+    K: [40, 0, 32, 0, 40, 24, 0, 0, 1]
+    T_camera_lidar: [0, -1, 0, 0.1,  0, 0, -1, 0.2,  1, 0, 0, 0.3,  0, 0, 0, 1]
+)");
+  const RigFile rig = readRigFile(tmp.path() / "rig.yaml");
+  EXPECT_TRUE(rig.base_is_lidar);
+  const Camera& cam = rig.rig.cameras[0];
+  EXPECT_DOUBLE_EQ(cam.fx, 40.0);
+  EXPECT_DOUBLE_EQ(cam.cy, 24.0);
+  EXPECT_NEAR(
+      (cam.T_camera_lidar * Eigen::Vector3d(1, 0, 0) - Eigen::Vector3d(0.1, 0.2, 1.3)).norm(), 0.0,
+      1e-12);
+}
+
+TEST(RigFile, ErrorsNameTheFileAndField) {
+  TempDir tmp;
+  const fs::path path = tmp.path() / "rig.yaml";
+  const std::string head =
+      "rig_format_version: 1\ncameras:\n  - name: c\n    width: 64\n"
+      "    height: 48\n    fx: 40\n    fy: 40\n    cx: 32\n    cy: 24\n";
+  auto error = [&](const std::string& text) {
+    writeText(path, text);
+    return errorOf([&] { readRigFile(path); });
+  };
+  const std::string both = error(head +
+                                 "    T_camera_lidar: {translation: [0,0,0], quaternion_xyzw: "
+                                 "[0,0,0,1]}\n    T_lidar_camera: {translation: [0,0,0], "
+                                 "quaternion_xyzw: [0,0,0,1]}\n");
+  EXPECT_NE(both.find(path.string()), std::string::npos) << both;
+  EXPECT_NE(both.find("not both"), std::string::npos) << both;
+  EXPECT_NE(error(head).find("cameras[0]: missing the extrinsic"), std::string::npos);
+  EXPECT_NE(error(head + "    T_camera_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 2]\n")
+                .find("last row"),
+            std::string::npos);
+  EXPECT_NE(error(head + "    model: fisheye\n    T_camera_lidar: {translation: [0,0,0], "
+                         "quaternion_xyzw: [0,0,0,1]}\n")
+                .find("cameras[0].model"),
+            std::string::npos);
+  EXPECT_NE(error(head + "    quaternion: 1\n").find("unknown key 'quaternion'"),
+            std::string::npos);
+  EXPECT_NE(error("rig_format_version: 2\n").find("version"), std::string::npos);
+  // A reflection is not a rotation: a matrix read backwards or mistyped is caught.
+  EXPECT_NE(error(head + "    T_camera_lidar: [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n")
+                .find("rotation"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { readRigFile(tmp.path()); }).find("is a directory"), std::string::npos);
+}
+
+// ------------------------------------------------------------------------------------------
+// Point records of any layout.
+
+TEST(PointFields, DecodesPaddedFloat64LayoutsWithTimes) {
+  // x y z as float64, intensity uint16, 6 bytes of padding, time uint32 ns: 38-byte records.
+  const std::vector<PointFieldSpec> fields = {{"x", 0, FieldType::kFloat64, 1},
+                                              {"y", 8, FieldType::kFloat64, 1},
+                                              {"z", 16, FieldType::kFloat64, 1},
+                                              {"intensity", 24, FieldType::kUint16, 1},
+                                              {"t", 32, FieldType::kUint32, 1}};
+  const size_t step = 38;
+  std::vector<uint8_t> data(3 * step, 0);
+  auto put = [&](size_t i, double x, double y, double z, uint16_t v, uint32_t t) {
+    uint8_t* r = data.data() + i * step;
+    std::memcpy(r, &x, 8);
+    std::memcpy(r + 8, &y, 8);
+    std::memcpy(r + 16, &z, 8);
+    std::memcpy(r + 24, &v, 2);
+    std::memcpy(r + 32, &t, 4);
+  };
+  put(0, 1.5, -2.0, 0.25, 7, 0);
+  put(1, std::nan(""), 0, 0, 0, 50000000);  // an organized cloud's empty cell
+  put(2, 3.0, 4.0, 5.0, 300, 99000000);
+  const DecodedPoints d = decodePointFields(fields, step, data.data(), data.size(), 3, "cloud");
+  ASSERT_EQ(d.points.size(), 2u);
+  EXPECT_EQ(d.dropped_invalid, 1u);
+  EXPECT_FLOAT_EQ(d.points[0].x, 1.5f);
+  EXPECT_FLOAT_EQ(d.points[1].z, 5.0f);
+  EXPECT_FLOAT_EQ(d.points[1].intensity, 300.0f);
+  ASSERT_EQ(d.times.size(), 2u);
+  EXPECT_NEAR(d.times[1], 0.099, 1e-12);  // integers are nanoseconds
+  EXPECT_EQ(d.time_field, "t");
+
+  EXPECT_NE(errorOf([&] {
+              decodePointFields(fields, step, data.data(), 100, 3, "cloud");
+            }).find("cloud: 3 points"),
+            std::string::npos);
+  const std::vector<PointFieldSpec> no_z = {{"x", 0, FieldType::kFloat32, 1},
+                                            {"y", 4, FieldType::kFloat32, 1}};
+  EXPECT_NE(
+      errorOf([&] { decodePointFields(no_z, 8, data.data(), 8, 1, "cloud"); }).find("no 'z' field"),
+      std::string::npos);
+  const std::vector<PointFieldSpec> outside = {{"x", 0, FieldType::kFloat32, 1},
+                                               {"y", 4, FieldType::kFloat32, 1},
+                                               {"z", 8, FieldType::kFloat64, 1}};
+  const std::string outside_error =
+      errorOf([&] { decodePointFields(outside, 12, data.data(), 12, 1, "cloud"); });
+  EXPECT_NE(outside_error.find("field 'z' at offset 8 does not fit"), std::string::npos)
+      << outside_error;
+}
+
+TEST(PointFields, AbsoluteTimesBecomeRelative) {
+  const std::vector<float> rel = relativePointTimes({1650000000.05, 1650000000.08}, 1650000000.0);
+  EXPECT_NEAR(rel[0], 0.05, 1e-6);
+  EXPECT_NEAR(rel[1], 0.08, 1e-6);
+  const std::vector<float> kept = relativePointTimes({0.01, 0.02}, 1650000000.0);
+  EXPECT_NEAR(kept[1], 0.02, 1e-7);
+}
+
+#if SEMSEGMAP_WITH_PCL
+TEST(PointCloudFile, ReadsPcdInEveryEncodingAndRefusesTruncation) {
+  TempDir tmp;
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  for (int i = 0; i < 100; ++i)
+    cloud.push_back(pcl::PointXYZI(static_cast<float>(i), 0.5f * i, -1.0f, 0.25f * i));
+  pcl::io::savePCDFileASCII((tmp.path() / "a.pcd").string(), cloud);
+  pcl::io::savePCDFileBinary((tmp.path() / "b.pcd").string(), cloud);
+  pcl::io::savePCDFileBinaryCompressed((tmp.path() / "c.pcd").string(), cloud);
+  for (const char* name : {"a.pcd", "b.pcd", "c.pcd"}) {
+    const DecodedPoints d = readPointCloudFile(tmp.path() / name);
+    ASSERT_EQ(d.points.size(), 100u) << name;
+    EXPECT_FLOAT_EQ(d.points[42].y, 21.0f) << name;
+    EXPECT_FLOAT_EQ(d.points[42].intensity, 10.5f) << name;
+  }
+  // Cut the binary file in the middle of its points.
+  const std::string bytes = readFileBytes(tmp.path() / "b.pcd");
+  writeBytesAtomically(tmp.path() / "t.pcd", bytes.substr(0, bytes.size() - 200));
+  const std::string truncated = errorOf([&] { readPointCloudFile(tmp.path() / "t.pcd"); });
+  EXPECT_NE(truncated.find("t.pcd: truncated"), std::string::npos) << truncated;
+  // An ASCII file whose header promises more points than it holds.
+  std::string ascii = readFileBytes(tmp.path() / "a.pcd");
+  ascii.replace(ascii.find("POINTS 100"), 10, "POINTS 120");
+  ascii.replace(ascii.find("WIDTH 100"), 9, "WIDTH 120");
+  writeBytesAtomically(tmp.path() / "w.pcd", ascii);
+  const std::string wrong = errorOf([&] { readPointCloudFile(tmp.path() / "w.pcd"); });
+  EXPECT_NE(wrong.find("w.pcd"), std::string::npos) << wrong;
+  EXPECT_NE(errorOf([&] { readPointCloudFile(tmp.path() / "none.pcd"); }).find("no such file"),
+            std::string::npos);
+}
+
+TEST(PointCloudFile, ReadsPlyInBothEncodings) {
+  TempDir tmp;
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  for (int i = 0; i < 30; ++i)
+    cloud.push_back(pcl::PointXYZI(0.5f * i, -1.0f * i, 2.0f, static_cast<float>(i)));
+  pcl::io::savePLYFileASCII((tmp.path() / "a.ply").string(), cloud);
+  pcl::io::savePLYFileBinary((tmp.path() / "b.ply").string(), cloud);
+  for (const char* name : {"a.ply", "b.ply"}) {
+    const DecodedPoints d = readPointCloudFile(tmp.path() / name);
+    ASSERT_EQ(d.points.size(), 30u) << name;
+    EXPECT_FLOAT_EQ(d.points[7].x, 3.5f) << name;
+    EXPECT_FLOAT_EQ(d.points[7].y, -7.0f) << name;
+    EXPECT_FLOAT_EQ(d.points[7].intensity, 7.0f) << name;
+  }
+  writeText(tmp.path() / "bad.ply", "ply\nformat ascii 1.0\nelement vertex 5\nend_header\n1 2\n");
+  EXPECT_NE(errorOf([&] { readPointCloudFile(tmp.path() / "bad.ply"); }).find("bad.ply"),
+            std::string::npos);
+}
+#endif
+
+// ------------------------------------------------------------------------------------------
+// Folders of scans and pictures, and pose files.
+
+namespace {
+
+// A folder of `n` scans (KITTI .bin, named by nanosecond times 0.1 s apart) and pictures of
+// camera "front" (named by times 0.01 s later), with the rig above.
+fs::path writeFolder(const fs::path& root, size_t n, int picture_width = 64) {
+  writeText(root / "rig.yaml", kRig);
+  fs::create_directories(root / "scans");
+  fs::create_directories(root / "front");
+  for (size_t i = 0; i < n; ++i) {
+    const long long ns = 1650000000000000000LL + static_cast<long long>(i) * 100000000LL;
+    std::vector<LidarPoint> points;
+    for (int k = 0; k < 50; ++k)
+      points.push_back({5.0f + 0.1f * k, 0.05f * k - 1.0f, 0.1f * static_cast<float>(i), 1.0f});
+    writeLidarBin(root / "scans" / (std::to_string(ns) + ".bin"), points);
+    Image picture(picture_width, 48, 3);
+    std::fill(picture.data.begin(), picture.data.end(), static_cast<uint8_t>(10 * i));
+    writePng(root / "front" / (std::to_string(ns + 10000000LL) + ".png"), picture);
+  }
+  return root;
+}
+
+}  // namespace
+
+TEST(FolderReader, PairsScansAndPicturesByTheTimesInTheirNames) {
+  TempDir tmp;
+  const fs::path dir = writeFolder(tmp.path() / "rec", 4);
+  FolderReader reader(dir, {});
+  ASSERT_EQ(reader.size(), 4u);
+  EXPECT_FALSE(reader.info().has_odometry);
+  EXPECT_EQ(reader.info().name, "test-rig");
+  const Frame f = reader.frame(2);
+  EXPECT_NEAR(f.timestamp_s, 1650000000.2, 1e-6);
+  ASSERT_EQ(f.points.size(), 50u);
+  EXPECT_FLOAT_EQ(f.points[0].z, 0.2f);
+  ASSERT_EQ(f.cameras.size(), 1u);
+  EXPECT_EQ(f.cameras[0].rgb.data[0], 20);  // the picture 0.01 s after scan 2, not another
+  EXPECT_NEAR(reader.frameTime(3), 1650000000.3, 1e-6);
+}
+
+TEST(FolderReader, NeverPairsAFarPicture) {
+  TempDir tmp;
+  const fs::path dir = writeFolder(tmp.path() / "rec", 3);
+  // Move the pictures 1 s later (1.01..1.21 s, the scans are at 0..0.2 s): with half the
+  // period (0.05 s) no scan has a picture near it.
+  for (const auto& e : fs::directory_iterator(dir / "front")) {
+    const long long ns = std::stoll(e.path().stem().string()) + 1000000000LL;
+    fs::rename(e.path(), dir / "front" / (std::to_string(ns) + ".png"));
+  }
+  const std::string error = errorOf([&] { FolderReader(dir, {}); });
+  EXPECT_NE(error.find("no picture of camera 'front' lies within"), std::string::npos) << error;
+  FolderOptions loose;
+  loose.tolerance_s = 0.9;  // scan 2 (0.2 s) reaches the first picture (1.01 s), scan 0 does not
+  FolderReader reader(dir, loose);
+  EXPECT_TRUE(reader.frame(0).cameras[0].rgb.empty());
+  EXPECT_EQ(reader.frame(2).cameras[0].rgb.data[0], 0);
+}
+
+TEST(FolderReader, RefusesPicturesOfAnotherSize) {
+  TempDir tmp;
+  const fs::path dir = writeFolder(tmp.path() / "rec", 2, 80);
+  const std::string error = errorOf([&] { FolderReader(dir, {}); });
+  EXPECT_NE(error.find(".png: the picture is 80x48 but camera 'front' of the rig is 64x48"),
+            std::string::npos)
+      << error;
+}
+
+TEST(FolderReader, NumberedScansWithoutARigAreLidarOnly) {
+  TempDir tmp;
+  for (int i = 0; i < 3; ++i)
+    writeLidarBin(tmp.path() / frameFileName(static_cast<size_t>(i), "bin"),
+                  {{1.0f, 2.0f, 3.0f, 0.0f}});
+  FolderReader reader(tmp.path(), {});
+  EXPECT_TRUE(reader.info().rig.cameras.empty());
+  EXPECT_NEAR(reader.frameTime(2), 0.2, 1e-12);  // 10 Hz, in name order
+  EXPECT_EQ(timeFromFileName("000042"), std::nullopt);
+  EXPECT_NEAR(*timeFromFileName("1650000000.5"), 1650000000.5, 1e-6);
+  EXPECT_NEAR(*timeFromFileName("1650000000500"), 1650000000.5, 1e-6);  // ms
+  EXPECT_EQ(timeFromFileName("scan_7"), std::nullopt);
+}
+
+TEST(PoseFiles, TumIsInterpolatedAndScansOutsideAreLeftOut) {
+  TempDir tmp;
+  const fs::path dir = writeFolder(tmp.path() / "rec", 4);
+  // Odometry from 0.05 s to 0.25 s: scans 0 (0.0 s) and 3 (0.3 s) lie outside.
+  writeText(tmp.path() / "odom.tum",
+            "# t x y z qx qy qz qw\n1650000000.05 0 0 0 0 0 0 1\n"
+            "1650000000.25 2 0 0 0 0 0.7071068 0.7071068\n");
+  DatasetOptions options;
+  options.odometry = tmp.path() / "odom.tum";
+  auto source = openDataset("folder:" + dir.string(), options);
+  EXPECT_TRUE(source->info().has_odometry);
+  ASSERT_EQ(source->size(), 2u);
+  const Frame f = source->frame(0);  // scan 1, at 0.1 s: a quarter of the way
+  EXPECT_NEAR(f.timestamp_s, 1650000000.1, 1e-6);
+  EXPECT_NEAR(f.T_odom_base.translation().x(), 0.5, 1e-6);
+  EXPECT_NEAR(yawOf(f.T_odom_base), 0.25 * M_PI / 2, 1e-6);
+}
+
+TEST(PoseFiles, KittiPairsByIndexAndCountsMustSuffice) {
+  TempDir tmp;
+  const fs::path dir = writeFolder(tmp.path() / "rec", 3);
+  writeText(tmp.path() / "gt.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n");
+  DatasetOptions options;
+  options.ground_truth = tmp.path() / "gt.txt";
+  const std::string few = errorOf([&] { openDataset("folder:" + dir.string(), options); });
+  EXPECT_NE(few.find("gt.txt: 2 KITTI poses for 3 scans"), std::string::npos) << few;
+  writeText(tmp.path() / "gt.txt",
+            "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n"
+            "1 0 0 2 0 1 0 0 0 0 1 0\n");
+  auto source = openDataset("folder:" + dir.string(), options);
+  EXPECT_TRUE(source->info().has_ground_truth_poses);
+  EXPECT_FALSE(source->info().has_odometry);
+  EXPECT_NEAR(source->frame(2).T_world_base->translation().x(), 2.0, 1e-12);
+  writeText(tmp.path() / "bad.txt", "1 2 3\n");
+  options.ground_truth = tmp.path() / "bad.txt";
+  EXPECT_NE(errorOf([&] {
+              openDataset("folder:" + dir.string(), options);
+            }).find("bad.txt: expected 8 numbers per line"),
+            std::string::npos);
+}
+
+TEST(PoseFiles, ARunWithoutOdometryIsRefusedUpFront) {
+  TempDir tmp;
+  const fs::path dir = writeFolder(tmp.path() / "rec", 2);
+  auto source = openDataset("folder:" + dir.string());
+  const std::string error = errorOf(
+      [&] { Pipeline pipe(PipelineConfig{}, source->info(), PoseSource::kOdometry, nullptr); });
+  EXPECT_NE(error.find("has no odometry: give --odometry FILE"), std::string::npos) << error;
+}
+
+// ------------------------------------------------------------------------------------------
+// The real samples.
+
+TEST(RealSamples, KittiPcdFolderWithGroundTruth) {
+  const fs::path dir = kShared / "kitti00_first10_pcd";
+  if (!fs::exists(dir))
+    GTEST_SKIP() << "the real KITTI PCD sample is absent (" << dir.string()
+                 << "): ../shared/data is not beside this checkout";
+#if !SEMSEGMAP_WITH_PCL
+  GTEST_SKIP() << "PCD files are read with PCL, which this build leaves out";
+#endif
+  DatasetOptions options;
+  options.ground_truth = dir / "poses.txt";  // camera-0 poses; calib.txt beside it says Tr
+  auto source = openDataset("folder:" + dir.string(), options);
+  ASSERT_EQ(source->size(), 10u);
+  const Frame f0 = source->frame(0), f9 = source->frame(9);
+  EXPECT_GT(f0.points.size(), 100000u);
+  // LiDAR poses: the car drives along the LiDAR's +x, about 0.86 m a frame, staying level.
+  const Eigen::Vector3d moved = f9.T_world_base->translation() - f0.T_world_base->translation();
+  EXPECT_NEAR(moved.x(), 9 * 0.86, 0.3);
+  EXPECT_LT(std::abs(moved.z()), 0.4);
+  EXPECT_LT(std::abs(moved.y()), 0.8);
+}
+
+TEST(RealSamples, PjlabPointsLandOnTheirPicture) {
+  const fs::path dir = kShared / "pjlab_lidar_camera_sample";
+  if (!fs::exists(dir))
+    GTEST_SKIP() << "the real PJLab sample is absent (" << dir.string()
+                 << "): ../shared/data is not beside this checkout";
+#if !SEMSEGMAP_WITH_PCL
+  GTEST_SKIP() << "PCD files are read with PCL, which this build leaves out";
+#endif
+  DatasetOptions options;
+  options.rig = fs::path(SEMSEGMAP_SOURCE_DIR) / "examples" / "pjlab" / "rig.yaml";
+  auto source = openDataset("folder:" + dir.string(), options);
+  ASSERT_EQ(source->size(), 1u);
+  const Frame f = source->frame(0);
+  ASSERT_EQ(f.cameras.size(), 1u);
+  EXPECT_EQ(f.cameras[0].rgb.width, 1920);
+  const EnrichedCloud cloud = enrichFrame(f, source->info().rig, EnrichmentConfig{});
+  size_t coloured = 0;
+  for (const EnrichedPoint& p : cloud) coloured += p.has_color;
+  // A front camera sees the part of the sweep ahead of it: thousands of points, not all.
+  EXPECT_GT(coloured, 5000u);
+  EXPECT_LT(coloured, cloud.size() / 2);
+}
+
+// ------------------------------------------------------------------------------------------
+// Converting a folder gives the frames that reading it directly gives.
+
+#if SEMSEGMAP_WITH_PCL
+TEST(ConvertFolder, SameFramesAsReadingDirectly) {
+  TempDir tmp;
+  const fs::path dir = writeFolder(tmp.path() / "rec", 3);
+  // Replace the .bin scans by ASCII PCD scans with a per-point time field (float seconds).
+  for (const auto& e : fs::directory_iterator(dir / "scans")) {
+    std::string pcd =
+        "VERSION 0.7\nFIELDS x y z intensity t\nSIZE 4 4 4 4 4\nTYPE F F F F F\n"
+        "COUNT 1 1 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n";
+    pcd += "1 2 3 4 0.01\n5 6 7 8 0.02\n9 10 11 12 0.05\n";
+    writeText(e.path().parent_path() / (e.path().stem().string() + ".pcd"), pcd);
+    fs::remove(e.path());
+  }
+  FolderReader direct(dir, {});
+  {
+    DatasetWriter writer(tmp.path() / "converted", direct.info());
+    for (size_t i = 0; i < direct.size(); ++i) writer.write(direct.frame(i));
+  }
+  auto converted = openDataset((tmp.path() / "converted").string());
+  EXPECT_FALSE(converted->info().has_odometry);
+  const Camera& cam = converted->info().rig.cameras.at(0);
+  EXPECT_EQ(cam.model, CameraModel::kRadialTangential);
+  EXPECT_EQ(cam.distortion, direct.info().rig.cameras[0].distortion);
+  ASSERT_EQ(converted->size(), direct.size());
+  for (size_t i = 0; i < direct.size(); ++i) {
+    const Frame a = direct.frame(i), b = converted->frame(i);
+    EXPECT_EQ(a.timestamp_s, b.timestamp_s);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    for (size_t k = 0; k < a.points.size(); ++k) EXPECT_EQ(a.points[k].z, b.points[k].z);
+    EXPECT_EQ(a.point_times, b.point_times);
+    EXPECT_EQ(b.point_times.size(), 3u);
+    EXPECT_EQ(a.cameras[0].rgb.data, b.cameras[0].rgb.data);
+  }
+}
+#endif
