@@ -16,6 +16,8 @@ class DatasetReader : public FrameSource {
   size_t size() const override { return rows_.size(); }
   // Loads the frame's files; a missing, truncated or mis-sized file throws naming that file.
   Frame frame(size_t index) override;
+  // From frames.csv: pose files pair scans by time without reading them.
+  double frameTime(size_t index) override { return rows_.at(index).timestamp_s; }
 
  private:
   struct Row {

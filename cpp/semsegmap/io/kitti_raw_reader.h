@@ -29,6 +29,8 @@ class KittiRawReader : public FrameSource {
   // Reads the scan, the image and the oxts record of frame `index`; a truncated scan, a
   // non-finite coordinate or an image whose size differs from S_rect_02 throws naming the file.
   Frame frame(size_t index) override;
+  // Known from the listing: pose files pair scans by time without reading them.
+  double frameTime(size_t index) override { return frames_.at(index).timestamp_s; }
 
  private:
   struct FrameFiles {

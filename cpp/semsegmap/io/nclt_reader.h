@@ -39,6 +39,8 @@ class NcltReader : public FrameSource {
   size_t size() const override { return frames_.size(); }
   // Decodes the scan; a file whose size is not a multiple of 8 bytes throws "<file>: truncated".
   Frame frame(size_t index) override;
+  // Known from the listing: pose files pair scans by time without reading them.
+  double frameTime(size_t index) override { return frames_.at(index).timestamp_s; }
 
  private:
   struct FrameFiles {

@@ -44,6 +44,8 @@ class SemanticKittiReader : public FrameSource {
   // Reads the scan and its labels; a label count that differs from the point count, a truncated
   // file or a non-finite coordinate throws naming the file(s).
   Frame frame(size_t index) override;
+  // Known from the listing: pose files pair scans by time without reading them.
+  double frameTime(size_t index) override { return frames_.at(index).timestamp_s; }
 
  private:
   struct FrameFiles {
