@@ -1,13 +1,18 @@
 // The whole pipeline per frame on simulated S2 frames (full world), as a robot runs it while
 // localizing: enrichment, local map, segmentation, describing the changed segments with the
 // shipped model and querying a target map (built from the same stretch at sunrise beforehand,
-// untimed). Semantic segmentation of the images is not included, as in the paper (its labels
-// come from the simulator). Target: at least 20 Hz on 2 cores.
+// untimed). Arg 0: SemSegMap (0) or SegMap (1). Arg 1: the segmentation network in front: -1
+// none, the simulator's labels (as in the paper); 0 on every picture; r > 0 at r Hz per camera,
+// the scans in between taking its latest labels (bench_semantics.cpp has the network). Target:
+// at least 20 Hz on 2 cores without the network.
 #include <benchmark/benchmark.h>
 
+#include "semsegmap/core/atomic_file.h"
+#include "semsegmap/io/class_map_file.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/modes.h"
+#include "semsegmap/semantics/frame_labeler.h"
 #include "semsegmap/sim/simulator.h"
 
 using namespace semsegmap;
@@ -41,6 +46,21 @@ Recorded s2Frames(const std::string& condition, uint64_t traffic) {
   return Recorded(std::move(frames), s.info());
 }
 
+// The MobileNet-class network of bench_semantics.cpp on every camera, through Cityscapes' map.
+std::unique_ptr<FrameLabeler> networkLabeler(int64_t rate_hz) {
+  if (rate_hz < 0) return nullptr;
+  SemanticsConfig c;
+  c.model = std::string(SEMSEGMAP_ONNX_DIR) + "/mobilenet_seg.onnx";
+  c.rate_hz = static_cast<double>(rate_hz);
+  c.tolerance_s = 1.0;
+  c.replace_dataset_labels = true;
+  const std::string maps = std::string(SEMSEGMAP_SOURCE_DIR) + "/config/class_maps";
+  auto network = std::make_shared<SegmentationNetwork>(
+      c, readFileBytes(c.model), readClassMap(maps + "/cityscapes.yaml", ClassTable::Default()),
+      c.model);
+  return std::make_unique<FrameLabeler>(network);
+}
+
 void BM_WholePipeline(benchmark::State& state) {
   const std::string name = state.range(0) == 0 ? "semsegmap" : "segmap";
   const PipelineConfig config =
@@ -56,6 +76,7 @@ void BM_WholePipeline(benchmark::State& state) {
   static Recorded query = s2Frames("sunny", 12);
   const auto map = std::make_shared<const TargetMap>(
       runMapping(mapping, config, PoseSource::kGroundTruth, describer).map);
+  const std::unique_ptr<FrameLabeler> labeler = networkLabeler(state.range(1));
   std::unique_ptr<LocalizationSession> session;
   size_t i = 0, localized = 0, frames = 0;
   StageTimes total;
@@ -72,17 +93,25 @@ void BM_WholePipeline(benchmark::State& state) {
       i = 0;
       state.ResumeTiming();
     }
-    session->process(query.at(i++));
+    if (labeler) {
+      Frame f = query.at(i++);
+      labeler->label(f, "frame");
+      session->process(f);
+    } else {
+      session->process(query.at(i++));
+    }
     ++frames;
   }
   lap();
-  state.SetLabel(name + " + " + config.descriptor.kind);
+  state.SetLabel(name + " + " + config.descriptor.kind +
+                 (labeler ? " + network at " + std::to_string(state.range(1)) + " Hz" : ""));
   const double n = static_cast<double>(std::max<size_t>(1, frames));
   state.counters["localized"] = static_cast<double>(localized) / n;
   state.counters["enrich_ms"] = total.enrich_ms / n;
   state.counters["map_seg_ms"] = (total.local_map_ms + total.segment_ms) / n;
   state.counters["describe_ms"] = total.describe_ms / n;
   state.counters["localize_ms"] = total.localize_ms / n;
+  if (labeler) state.counters["network_ms"] = labeler->stats().network_ms / n;
   state.counters["Hz"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
 }
 // The front end alone (enrich, local map, segmentation; no describing or querying) on the
@@ -111,8 +140,10 @@ void BM_PipelineFrontEnd(benchmark::State& state) {
 BENCHMARK(BM_PipelineFrontEnd)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(160);
 
 BENCHMARK(BM_WholePipeline)
-    ->Arg(0)
-    ->Arg(1)
+    ->Args({0, -1})
+    ->Args({1, -1})
+    ->Args({0, 0})
+    ->Args({0, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(160);

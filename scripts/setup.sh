@@ -14,6 +14,8 @@ packages=(
   librosbag-storage-dev libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
   libtf2-msgs-dev
   gnuplot-nox
+  # the tests and the benchmark generate their small ONNX segmentation networks with it
+  python3-onnx python3-numpy
   # make bench only: the odometry benchmark compares Open3D's registration (optional in CMake)
   libopen3d-dev
 )

@@ -70,26 +70,31 @@ const std::vector<CommandOptions> kAllCommands = {
      {"world-seed", "world", "out", "cameras", "run", "frame"},
      {"max-frames", "dataset"}},
     {"enrich",
-     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "frame", "out", "width", "ply",
-      "camera"},
-     {"max-frames", "config"}},
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "frame", "out",
+      "width", "ply", "camera", "config"},
+     {"max-frames", "map"}},
+    {"label",
+     {"dataset", "rig", "ground-truth", "kitti-calib", "labels", "config", "out", "max-frames"},
+     {"odometry", "map"}},
     {"convert",
-     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "out", "max-frames"},
-     {"config", "world-seed"}},
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "out", "max-frames",
+      "config"},
+     {"world-seed", "map"}},
     {"segment",
-     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "out", "poses",
-      "max-frames"},
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
+      "poses", "max-frames"},
      {"map", "float32"}},
     {"map",
-     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "out", "poses",
-      "max-frames", "points", "float32"},
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
+      "poses", "max-frames", "points", "float32"},
      {"world-seed", "map"}},
     {"localize",
-     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "map", "out",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "map", "out",
       "max-frames"},
      {"poses", "float32"}},
     {"slam",
-     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "config", "out", "max-frames"},
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
+      "max-frames"},
      {"map", "poses"}},
     {"odometry",
      {"dataset", "rig", "ground-truth", "kitti-calib", "out", "config", "max-frames"},
@@ -107,7 +112,8 @@ const std::vector<CommandOptions> kAllCommands = {
       "descriptor-run"},
      {"configs", "map-run"}},
     {"eval localization",
-     {"world-seed", "out", "preset", "max-frames", "configs", "map-run", "query-runs"},
+     {"world-seed", "out", "preset", "max-frames", "configs", "map-run", "query-runs",
+      "label-noise", "odometry"},
      {"descriptors", "segmentation-run"}},
     {"eval paper",
      {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run", "config",
@@ -401,6 +407,43 @@ TEST(Cli, NoOdometryIsRefusedUpFrontNamingTheOptions) {
     EXPECT_NE(r.err.find("has no odometry: give --odometry FILE"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(tmp.path() / "out")) << command;
   }
+}
+
+// The segmentation network as a user runs it: `label` writes a label set once (with a preview to
+// look at), later commands read it with --labels; a config without a network, or a label set of
+// another dataset, is refused in one line before any frame.
+TEST(Cli, LabelWritesALabelSetThatLaterCommandsRead) {
+  if (!SEMSEGMAP_WITH_SIM) GTEST_SKIP() << "the pictures come from the simulator";
+  TempDir tmp;
+  const auto dir = tmp.path();
+  std::ofstream(dir / "colour.yaml")
+      << "name: colour4\nclasses:\n  - {id: 0, name: red, class: building}\n"
+         "  - {id: 1, name: green, class: vegetation}\n  - {id: 2, name: blue, class: sky}\n"
+         "  - {id: 3, name: dark, class: road}\n";
+  std::ofstream(dir / "net.yaml") << "semantics:\n  model: " SEMSEGMAP_ONNX_DIR
+                                     "/colour4.onnx\n"
+                                     "  class_map: colour.yaml\n  mean: [0, 0, 0]\n"
+                                     "  std: [1, 1, 1]\n  replace_dataset_labels: true\n";
+  const std::string data = " --dataset sim:preset=tiny,frames=2";
+  const Result r = run("label" + data + " --config " + (dir / "net.yaml").string() + " --out " +
+                       (dir / "labels").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("label images 6: network 6"), std::string::npos) << r.out;
+  for (const char* file : {"labels.yaml", "preview.png", "cam0/000000.png", "cam2/000001.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "labels" / file)) << file;
+  const Result enrich = run("enrich" + data + " --labels " + (dir / "labels").string() + " --out " +
+                            (dir / "e.png").string());
+  EXPECT_EQ(enrich.code, 0) << enrich.err;
+  std::ofstream(dir / "none.yaml") << "semantics:\n  class_map: cityscapes\n";
+  const Result none = run("label" + data + " --config " + (dir / "none.yaml").string() + " --out " +
+                          (dir / "l2").string());
+  EXPECT_EQ(none.code, 1);
+  EXPECT_NE(none.err.find("none.yaml: semantics.model: empty"), std::string::npos) << none.err;
+  const Result other = run("enrich --dataset sim:preset=tiny,frames=3 --labels " +
+                           (dir / "labels").string() + " --out " + (dir / "e2.png").string());
+  EXPECT_EQ(other.code, 1);
+  EXPECT_NE(other.err.find("labels a dataset of 2 frames, this one has 3"), std::string::npos)
+      << other.err;
 }
 
 }  // namespace

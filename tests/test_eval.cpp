@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "semsegmap/eval/descriptor_eval.h"
 #include "semsegmap/eval/retrieval.h"
 
 using namespace semsegmap;
@@ -30,4 +31,27 @@ TEST(Retrieval, CumulativeCurveOfKnownRanks) {
   EXPECT_DOUBLE_EQ(curve[1], 0.6);
   EXPECT_DOUBLE_EQ(curve[3], 0.6);
   EXPECT_DOUBLE_EQ(curve[4], 0.8);
+}
+
+TEST(Retrieval, QueriesRankAgainstTheFinalObservationTrainingUses) {
+  // Segment 5 is seen three times and shrinks at the end (a split); segment 6 once (no query).
+  TrainingSet set;
+  set.sources = {"sim:"};
+  const std::vector<std::pair<int64_t, uint32_t>> seen = {{5, 100}, {6, 50}, {5, 400}, {5, 200}};
+  for (const auto& [segment, n] : seen) {
+    TrainingObservation o;
+    o.segment = segment;
+    o.n_points = n;
+    set.observations.push_back(o);
+  }
+  const RetrievalQueries q = makeRetrievalQueries(set);
+  const std::vector<bool> final = finalObservations(set);
+  ASSERT_EQ(q.targets, (std::vector<size_t>{3}));  // the last observation, not the largest
+  EXPECT_TRUE(final[q.targets[0]]);
+  EXPECT_EQ(q.queries, (std::vector<size_t>{0, 2}));
+  EXPECT_EQ(q.truth, (std::vector<int>{0, 0}));
+  EXPECT_DOUBLE_EQ(q.completeness[0], 0.5);
+  EXPECT_DOUBLE_EQ(q.completeness[1], 2.0);  // larger than the final one: in the top band
+  const auto bands = defaultCompletenessBands();
+  EXPECT_TRUE(q.completeness[1] >= bands.back().lo && q.completeness[1] < bands.back().hi);
 }

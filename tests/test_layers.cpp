@@ -13,8 +13,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::set<std::string> kStages = {"enrich", "local_map", "segment",  "describe", "localize",
-                                       "graph",  "odometry",  "pipeline", "learn"};
+const std::set<std::string> kStages = {"semantics", "enrich", "local_map", "segment",  "describe",
+                                       "localize",  "graph",  "odometry",  "pipeline", "learn"};
 
 std::set<std::string> with(std::set<std::string> s, const std::set<std::string>& more) {
   s.insert(more.begin(), more.end());
@@ -23,13 +23,14 @@ std::set<std::string> with(std::set<std::string> s, const std::set<std::string>&
 
 // Folder -> the folders it may include from (its own is always allowed).
 std::map<std::string, std::set<std::string>> makeTable() {
-  const std::set<std::string> stages = {"core",     "enrich",   "local_map", "segment",
-                                        "describe", "localize", "graph",     "odometry"};
+  const std::set<std::string> stages = {"core",     "semantics", "enrich", "local_map", "segment",
+                                        "describe", "localize",  "graph",  "odometry"};
   const std::set<std::string> below_io = with(stages, {"pipeline", "learn"});
   const std::set<std::string> below_viz = with(below_io, {"io", "sim", "datasets"});
   return {
       {"core", {}},
       {"sim", {"core"}},
+      {"semantics", {"core"}},
       {"enrich", {"core"}},
       {"local_map", {"core"}},
       {"segment", {"core", "local_map"}},

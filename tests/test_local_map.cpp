@@ -77,7 +77,9 @@ TEST(Votes, MajorityKeptWhenLabelsOutnumberSlots) {
 }
 
 TEST(LocalMap, DynamicAndGroundClassesAreRemovedByConfiguration) {
-  LocalMap map = makeMap();
+  LocalMapConfig by_point;
+  by_point.dynamic_removal = DynamicRemoval::kPoint;
+  LocalMap map = makeMap(by_point);
   const LocalMapUpdate u = map.update(
       {point(1, 0, 1, cls::kCar), point(2, 0, 0, cls::kRoad), point(3, 0, 0, cls::kTerrain),
        point(4, 0, 1, cls::kPerson), point(5, 0, 1, cls::kBuilding)},
@@ -92,6 +94,46 @@ TEST(LocalMap, DynamicAndGroundClassesAreRemovedByConfiguration) {
       all.update({point(1, 0, 1, cls::kCar), point(2, 0, 0, cls::kRoad)}, Pose::Identity(), {0, 0})
           .points_inserted,
       2u);
+}
+
+// A real network labels the edge of a moving truck as the building behind it and some building
+// pixels as truck. By point, the truck's mislabelled edge survives as a static voxel; by voxel,
+// the truck's voxel is dropped whole and the building's mislabelled points stay in its geometry.
+TEST(LocalMap, DynamicVoxelsAreDroppedByMajorityVote) {
+  EnrichedCloud scan;
+  for (int k = 0; k < 4; ++k) scan.push_back(point(5.05f, 0.05f, 1.05f, cls::kCar));  // truck
+  scan.push_back(point(5.05f, 0.05f, 1.05f, cls::kBuilding));  // its edge, mislabelled
+  for (int k = 0; k < 3; ++k) scan.push_back(point(8.05f, 0.05f, 1.05f, cls::kBuilding));
+  scan.push_back(point(8.05f, 0.05f, 1.05f, cls::kCar));  // a building pixel called truck
+  const VoxelKey truck = packVoxelKey({50, 0, 10}), wall = packVoxelKey({80, 0, 10});
+
+  LocalMapConfig by_point;
+  by_point.dynamic_removal = DynamicRemoval::kPoint;
+  LocalMap old_way = makeMap(by_point);
+  old_way.update(scan, Pose::Identity(), {0, 0});
+  ASSERT_NE(old_way.find(truck), nullptr);
+  EXPECT_TRUE(old_way.find(truck)->active);  // the edge survives as a static "building" voxel
+  EXPECT_EQ(old_way.find(wall)->n_points, 3u);
+
+  LocalMap map = makeMap();  // by voxel, the default
+  const LocalMapUpdate u = map.update(scan, Pose::Identity(), {0, 0});
+  EXPECT_EQ(u.newly_active, std::vector<VoxelKey>{wall});
+  EXPECT_FALSE(map.find(truck)->active);
+  const Voxel& w = *map.find(wall);
+  EXPECT_EQ(w.n_points, 4u);  // the mislabelled point is still the wall's geometry
+  EXPECT_EQ(w.n_dynamic, 1u);
+  EXPECT_EQ(w.semanticClass(), cls::kBuilding);  // but never its class
+  // Votes carry over scans: static points arriving later turn the truck voxel static.
+  EnrichedCloud later;
+  for (int k = 0; k < 4; ++k) later.push_back(point(5.05f, 0.05f, 1.05f, cls::kBuilding));
+  EXPECT_EQ(map.update(later, Pose::Identity(), {0, 0}).newly_active, std::vector<VoxelKey>{truck});
+  // The share is configurable: with 0.8, 4 of 5 dynamic votes are not enough to drop it.
+  LocalMapConfig lenient;
+  lenient.dynamic_vote_share = 0.8;
+  LocalMap tolerant = makeMap(lenient);
+  EXPECT_EQ(tolerant.update(scan, Pose::Identity(), {0, 0}).newly_active.size(), 2u);
+  lenient.dynamic_vote_share = 1.0;
+  EXPECT_THROW(makeMap(lenient), std::invalid_argument);
 }
 
 TEST(LocalMap, VoxelsActivateAtTheMinimumCountAndLeaveTheCylinder) {

@@ -29,6 +29,7 @@
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/kitti_raw_reader.h"
+#include "semsegmap/io/point_fields.h"
 #include "semsegmap/io/ros_decode.h"
 #include "semsegmap/io/ros_serialization.h"
 #include "semsegmap/io/ros_tf.h"
@@ -41,6 +42,7 @@ namespace fs = std::filesystem;
 namespace rm = semsegmap::rosmsg;
 using semsegmap::Camera;
 using semsegmap::CameraModel;
+using semsegmap::FieldType;
 using semsegmap::Frame;
 using semsegmap::LidarPoint;
 using semsegmap::Pose;
@@ -72,6 +74,10 @@ struct FieldSpec {
   uint8_t datatype;
 };
 
+constexpr uint8_t dt(FieldType type) {
+  return static_cast<uint8_t>(type);
+}
+
 size_t sizeOf(uint8_t datatype) {
   static const size_t sizes[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
   return sizes[datatype];
@@ -80,25 +86,25 @@ size_t sizeOf(uint8_t datatype) {
 void storeAs(uint8_t* p, uint8_t datatype, double v) {
   auto put = [&](auto x) { std::memcpy(p, &x, sizeof(x)); };
   switch (datatype) {
-    case rm::PointField::kInt8:
+    case dt(FieldType::kInt8):
       put(static_cast<int8_t>(v));
       break;
-    case rm::PointField::kUint8:
+    case dt(FieldType::kUint8):
       put(static_cast<uint8_t>(v));
       break;
-    case rm::PointField::kInt16:
+    case dt(FieldType::kInt16):
       put(static_cast<int16_t>(v));
       break;
-    case rm::PointField::kUint16:
+    case dt(FieldType::kUint16):
       put(static_cast<uint16_t>(v));
       break;
-    case rm::PointField::kInt32:
+    case dt(FieldType::kInt32):
       put(static_cast<int32_t>(v));
       break;
-    case rm::PointField::kUint32:
+    case dt(FieldType::kUint32):
       put(static_cast<uint32_t>(v));
       break;
-    case rm::PointField::kFloat32:
+    case dt(FieldType::kFloat32):
       put(static_cast<float>(v));
       break;
     default:
@@ -486,12 +492,11 @@ TEST(PointCloud2, PerPointTimesInEachUnit) {
   };
   const double stamp = kEpoch + 0.5;
   const std::vector<Case> cases = {
-      {"t", rm::PointField::kUint32, [](size_t i) { return 1e6 * i; }},            // Ouster: ns
-      {"time", rm::PointField::kFloat32, [](size_t i) { return 0.001 * i; }},      // Velodyne: s
-      {"offset_time", rm::PointField::kUint32, [](size_t i) { return 1e6 * i; }},  // Livox: ns
-      {"timestamp", rm::PointField::kFloat64,
-       [&](size_t i) { return stamp + 0.001 * i; }},  // Hesai
-      {"timestamp", rm::PointField::kFloat64, [&](size_t i) { return (stamp + 0.001 * i) * 1e9; }},
+      {"t", dt(FieldType::kUint32), [](size_t i) { return 1e6 * i; }},            // Ouster: ns
+      {"time", dt(FieldType::kFloat32), [](size_t i) { return 0.001 * i; }},      // Velodyne: s
+      {"offset_time", dt(FieldType::kUint32), [](size_t i) { return 1e6 * i; }},  // Livox: ns
+      {"timestamp", dt(FieldType::kFloat64), [&](size_t i) { return stamp + 0.001 * i; }},  // Hesai
+      {"timestamp", dt(FieldType::kFloat64), [&](size_t i) { return (stamp + 0.001 * i) * 1e9; }},
   };
   for (const Case& c : cases) {
     const auto msg = makeCloud(

@@ -146,3 +146,85 @@ TEST(Simulator, DatasetWriteReadRoundTrip) {
   }
   std::filesystem::remove_all(dir);
 }
+
+namespace {
+
+// Share of pixels that differ between two label images.
+double changedShare(const Image& a, const Image& b) {
+  size_t changed = 0;
+  for (size_t i = 0; i < a.data.size(); ++i) changed += a.data[i] != b.data[i];
+  return static_cast<double>(changed) / a.data.size();
+}
+
+Image twoClasses(ClassId left, ClassId right) {  // 640 x 480, split at x = 320
+  Image img(640, 480, 1);
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < 640; ++x) *img.at(x, y) = static_cast<uint8_t>(x < 320 ? left : right);
+  return img;
+}
+
+}  // namespace
+
+TEST(LabelNoise, EachEffectChangesWhatItShould) {
+  const Image wall = twoClasses(cls::kBuilding, cls::kBuilding);
+  // Boundaries move by at most boundary_px, and only boundaries move.
+  const Image split = twoClasses(cls::kBuilding, cls::kRoad);
+  const Image shifted = applyLabelNoise(split, {8.0, 0, 0, 0}, 1);
+  EXPECT_GT(changedShare(split, shifted), 0.002);
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < 640; ++x)
+      if (*shifted.at(x, y) != *split.at(x, y)) {
+        ASSERT_LE(std::abs(x - 320), 9) << x << "," << y;
+      }
+  EXPECT_EQ(applyLabelNoise(wall, {8.0, 0, 0, 0}, 1), wall);
+  // Confusion and wrong regions take about their share of the picture (averaged over seeds:
+  // the blobs are large, so one picture varies).
+  double confused = 0, region = 0;
+  for (uint64_t seed = 0; seed < 16; ++seed) {
+    confused += changedShare(wall, applyLabelNoise(wall, {0, 0.25, 0, 0}, seed)) / 16;
+    region += changedShare(wall, applyLabelNoise(wall, {0, 0, 0, 0.08}, seed)) / 16;
+  }
+  EXPECT_NEAR(confused, 0.25, 0.06);
+  EXPECT_LT(region, 0.08 * 1.6);  // a third of the regions draw the wall's own class
+  EXPECT_GT(region, 0.02);
+  // Thin objects: all missed at share 1, each pixel then takes its background.
+  Image pole = wall;
+  for (int y = 100; y < 400; ++y)
+    for (int x = 300; x < 306; ++x) *pole.at(x, y) = cls::kPole;
+  EXPECT_EQ(applyLabelNoise(pole, {0, 0, 1.0, 0}, 3), wall);
+  // Sky is never a wrong region, and unknown stays unknown.
+  const Image sky = twoClasses(cls::kSky, cls::kUnknown);
+  EXPECT_EQ(applyLabelNoise(sky, {0, 0, 0, 1.0}, 5), sky);
+}
+
+TEST(LabelNoise, LevelsAreDeterministicAndGrowWorse) {
+  EXPECT_THROW(labelNoiseOfLevel(4), std::invalid_argument);
+  Simulator perfect(tinyConfig());
+  double previous = 0.0;
+  for (int level = 0; level <= kMaxLabelNoiseLevel; ++level) {
+    SimConfig c = tinyConfig();
+    c.label_noise = level;
+    Simulator noisy(c);
+    double share = 0.0;
+    for (size_t i : {0, 5}) {
+      const Frame a = perfect.frame(i), b = noisy.frame(i);
+      EXPECT_EQ(a.point_labels, b.point_labels);  // the LiDAR's ground truth stays exact
+      for (size_t k = 0; k < a.cameras.size(); ++k)
+        share += changedShare(a.cameras[k].label, b.cameras[k].label) / (2 * a.cameras.size());
+    }
+    std::printf("label noise %d: %.1f %% of the pixels changed\n", level, 100 * share);
+    if (level == 0) {
+      EXPECT_EQ(share, 0.0);
+    } else if (level == 1) {
+      EXPECT_GT(share, 0.01);
+    } else if (level == 3) {
+      EXPECT_LT(share, 0.35);
+    }
+    if (level > 0) {
+      EXPECT_GT(share, previous * 1.3) << level;
+    }
+    previous = share;
+    // Deterministic: the same frame twice, from another simulator of the same seeds.
+    EXPECT_TRUE(sameFrame(noisy.frame(5), Simulator(c).frame(5)));
+  }
+}

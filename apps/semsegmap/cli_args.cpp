@@ -137,7 +137,8 @@ const char* const kDatasetNotes =
     "  rosbag:FILE.bag|FILE.db3|FILE.mcap|DIR[,lidar=T][,camera=T;T|none][,odometry=T]\n"
     "    [,base_frame=F][,odom_frame=F][,tolerance=S] (ROS 1 and ROS 2 bags),\n"
     "  "
-    "sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small][,sweep=1]\n";
+    "sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small][,sweep=1]\n"
+    "    [,label_noise=0..3] (the built-in simulator)\n";
 #else
     "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,\n"
     "  folder:DIR[,rig=FILE][,times=FILE][,tolerance=S] (scans and pictures, docs/rig-format.md),\n"

@@ -96,6 +96,7 @@ const CommandSpec& simulateCommand();
 const CommandSpec& simulateOverviewCommand();
 const CommandSpec& demoCommand();
 const CommandSpec& enrichCommand();
+const CommandSpec& labelCommand();
 const CommandSpec& convertCommand();
 const CommandSpec& segmentCommand();
 const CommandSpec& mapCommand();

@@ -1,5 +1,6 @@
 // semsegmap convert: any dataset the CLI reads (KITTI raw, SemanticKITTI, NCLT, the simulator)
-// written in the project's own format.
+// written in the project's own format (with the label images of --labels or of a --config's
+// segmentation network).
 #include <iostream>
 
 #include "cli_args.h"
@@ -34,6 +35,9 @@ const CommandSpec& convertCommand() {
                      {
                          {"out", Value::kText, "DIR", "", "dataset directory to write", kRequired},
                          maxFramesOption(),
+                         {"config", Value::kText, "FILE", "",
+                          "a config whose semantics: section labels the pictures that have no "
+                          "labels, so that the written dataset carries them"},
                      }),
       kDatasetNotes, runConvert};
   return command;

@@ -83,6 +83,8 @@ const CommandSpec& enrichCommand() {
               {"ply", Value::kText, "FILE.ply", "", "also write the enriched cloud"},
               {"camera", Value::kCount, "K", "",
                "the camera to draw on (default: 1, the front one, with three cameras, else 0)"},
+              {"config", Value::kText, "FILE", "",
+               "a config whose semantics: section labels pictures that have no labels"},
           }),
       kDatasetNotes, runEnrich};
   return command;

@@ -12,6 +12,7 @@
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/eval/report.h"
+#include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
 
 namespace semsegmap::app {
@@ -109,6 +110,15 @@ LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   // A describer this build does not have fails here, before the first frame.
   for (const NamedConfig& config : c.configs)
     requireDescriberBuilt(config.config.descriptor, config.path.string());
+  if (a.command().name != "eval localization") return c;  // the paper's setting otherwise
+  c.label_noise = static_cast<int>(a.getCount("label-noise"));
+  if (c.label_noise > 3) throw UsageError("--label-noise is 0 (perfect labels) to 3");
+  const std::string odometry = a.get("odometry");
+  if (odometry != "simulated" && odometry != "lidar")
+    throw UsageError("--odometry expects simulated or lidar, got '" + odometry + "'");
+  c.lidar_odometry = odometry == "lidar";
+  // LiDAR odometry takes the odometry: section of the first configuration.
+  if (c.lidar_odometry) c.odometry = loadOdometryConfig(c.configs.front().path);
   return c;
 }
 
@@ -193,6 +203,11 @@ const OptionSpec kMapRun{"map-run", Value::kText, "S0|S1|S2|S3", "S0",
                          "the run the target map is built from"};
 const OptionSpec kQueryRuns{"query-runs", Value::kText, "LIST", "S2,S3",
                             "the runs localized against the map"};
+const OptionSpec kLabelNoise{"label-noise", Value::kCount, "L", "0",
+                             "camera labels as a segmentation network's, 0 (perfect) to 3"};
+const OptionSpec kQueryOdometry{
+    "odometry", Value::kText, "simulated|lidar", "simulated",
+    "the query runs' odometry: the simulator's drifting one, or LiDAR odometry on their scans"};
 
 }  // namespace
 
@@ -213,7 +228,8 @@ const std::vector<const CommandSpec*>& evalCommands() {
   static const CommandSpec localization{
       "eval localization",
       "maps one run, localizes the others with each config -> localization.json",
-      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kMapRun, kQueryRuns},
+      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kMapRun, kQueryRuns, kLabelNoise,
+       kQueryOdometry},
       "",
       runEvalLocalization};
   static const CommandSpec paper{

@@ -54,7 +54,7 @@ const CommandSpec& odometryCommand() {
                           "a config whose odometry: section to use (default: built-in defaults)"},
                          maxFramesOption(),
                      },
-                     /*odometry_option=*/false),
+                     /*odometry_option=*/false, /*labels_option=*/false),
       kDatasetNotes, runOdometryCommand};
   return command;
 }

@@ -2,13 +2,14 @@
 
 #include <algorithm>
 
+#include "resources.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/config.h"
 
 namespace semsegmap::app {
 
 std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<OptionSpec> more,
-                                       bool odometry_option) {
+                                       bool odometry_option, bool labels_option) {
   std::vector<OptionSpec> options = {
       {"dataset", Value::kText, "SPEC", "", help, kRequired},
       {"rig", Value::kText, "FILE", "", "rig file of a folder: dataset (docs/rig-format.md)"},
@@ -19,11 +20,16 @@ std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<Opti
        "ground-truth poses of the base, TUM or KITTI format (replaces the dataset's)"},
       {"kitti-calib", Value::kText, "FILE", "",
        "KITTI calib.txt whose Tr turns KITTI camera-0 poses into LiDAR poses"},
+      {"labels", Value::kText, "DIR", "",
+       "label set whose images replace the dataset's (written by semsegmap label or another "
+       "tool, docs/class-maps.md)"},
   };
-  if (!odometry_option)
-    options.erase(std::remove_if(options.begin(), options.end(),
-                                 [](const OptionSpec& o) { return o.name == "odometry"; }),
-                  options.end());
+  options.erase(std::remove_if(options.begin(), options.end(),
+                               [&](const OptionSpec& o) {
+                                 return (o.name == "odometry" && !odometry_option) ||
+                                        (o.name == "labels" && !labels_option);
+                               }),
+                options.end());
   options.insert(options.end(), more.begin(), more.end());
   return options;
 }
@@ -40,6 +46,12 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a) {
   // LiDAR odometry takes its settings from the odometry section of the command's config.
   if (options.odometry == "lidar" && declares("config") && a.has("config"))
     options.lidar_odometry = loadOdometryConfig(a.get("config"));
+  // The segmentation network of the config's semantics: section labels pictures without labels.
+  if (declares("labels") && declares("config") && a.has("config"))
+    options.semantics = loadSemanticsConfig(a.get("config"));
+  if (declares("labels") && a.has("labels")) options.labels = a.get("labels");
+  if (!options.semantics.model.empty() || !options.labels.empty())
+    options.class_maps_dir = shippedFile("config/class_maps");
   if (a.has("ground-truth")) options.ground_truth = a.get("ground-truth");
   if (a.has("kitti-calib")) options.kitti_calib = a.get("kitti-calib");
   return openDataset(a.get("dataset"), options);

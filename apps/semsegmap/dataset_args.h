@@ -12,11 +12,13 @@
 namespace semsegmap::app {
 
 // --dataset (required, described by `help`), --rig, --odometry (unless the command makes the
-// odometry itself), --ground-truth, --kitti-calib, followed by `more`.
+// odometry itself), --ground-truth, --kitti-calib, --labels (unless the command reads no
+// labels), followed by `more`.
 std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<OptionSpec> more,
-                                       bool odometry_option = true);
+                                       bool odometry_option = true, bool labels_option = true);
 
-// openDataset() with those options.
+// openDataset() with those options. A command that takes --labels also gets the segmentation
+// network of its --config's semantics: section, when it names one.
 std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a);
 
 }  // namespace semsegmap::app

@@ -23,8 +23,8 @@ const std::vector<const CommandSpec*>& commands() {
 #if SEMSEGMAP_WITH_SIM
     c = {&simulateCommand(), &simulateOverviewCommand()};
 #endif
-    c.insert(c.end(), {&enrichCommand(), &convertCommand(), &segmentCommand(), &mapCommand(),
-                       &localizeCommand(), &slamCommand(), &odometryCommand()});
+    c.insert(c.end(), {&enrichCommand(), &labelCommand(), &convertCommand(), &segmentCommand(),
+                       &mapCommand(), &localizeCommand(), &slamCommand(), &odometryCommand()});
 #if SEMSEGMAP_WITH_TORCH
     c.push_back(&trainCommand());
 #endif

@@ -2,6 +2,7 @@
 // only sees this interface.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 
 #include "semsegmap/core/class_table.h"
@@ -35,6 +36,13 @@ class FrameSource {
   // The time of a frame; sources that know it without reading the frame say so faster.
   virtual double frameTime(size_t index) { return frame(index).timestamp_s; }
 };
+
+// What every FrameSource throws for an index past its end.
+[[noreturn]] inline void throwFrameOutOfRange(const std::string& dataset, size_t index,
+                                              size_t frames) {
+  throw std::out_of_range(dataset + ": frame " + std::to_string(index) + " out of range (" +
+                          std::to_string(frames) + " frames)");
+}
 
 // How many frames a run reads of `source`: the first max_frames, or all when it is 0.
 inline size_t framesToRead(const FrameSource& source, size_t max_frames) {

@@ -20,9 +20,7 @@ class LidarOdometrySource : public FrameSource {
   size_t size() const override { return source_->size(); }
 
   Frame frame(size_t index) override {
-    if (index >= size())
-      throw std::out_of_range(info_.name + ": frame " + std::to_string(index) + " of " +
-                              std::to_string(size()));
+    if (index >= size()) throwFrameOutOfRange(info_.name, index, size());
     if (index < poses_.size()) {
       Frame f = source_->frame(index);
       f.T_odom_base = poses_[index];

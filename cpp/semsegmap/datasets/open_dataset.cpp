@@ -7,6 +7,7 @@
 
 #include "semsegmap/datasets/lidar_odometry_source.h"
 #include "semsegmap/datasets/pose_files.h"
+#include "semsegmap/datasets/semantic_sources.h"
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/folder_reader.h"
 #if SEMSEGMAP_WITH_ROS
@@ -66,7 +67,13 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
       config.render_cameras = parseUnsigned(spec, key, value) != 0;
     else if (key == "sweep")
       config.lidar_sweep = parseUnsigned(spec, key, value) != 0;
-    else
+    else if (key == "label_noise") {
+      const uint64_t level = parseUnsigned(spec, key, value);
+      if (level > sim::kMaxLabelNoiseLevel)
+        throw std::invalid_argument("dataset '" + spec + "': label_noise is 0 (perfect) to " +
+                                    std::to_string(sim::kMaxLabelNoiseLevel) + ", got " + value);
+      config.label_noise = static_cast<int>(level);
+    } else
       throw std::invalid_argument("dataset '" + spec + "': unknown key '" + key + "'");
   }
   config.world = sim::worldPreset(preset, world_seed);
@@ -152,8 +159,12 @@ std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetO
   poses.ground_truth = options.ground_truth;
   poses.kitti_calib = options.kitti_calib;
   source = withPoseFiles(std::move(source), poses);
-  return lidar_odometry ? withLidarOdometry(std::move(source), options.lidar_odometry)
-                        : std::move(source);
+  if (lidar_odometry) source = withLidarOdometry(std::move(source), options.lidar_odometry);
+  if (!options.labels.empty())
+    source = withLabelSet(std::move(source), options.labels, options.class_maps_dir);
+  if (options.semantics.model.empty()) return source;
+  auto network = loadSegmentationNetwork(options.semantics, source->info(), options.class_maps_dir);
+  return withSegmentationNetwork(std::move(source), std::move(network));
 }
 
 }  // namespace semsegmap

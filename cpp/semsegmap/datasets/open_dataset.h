@@ -9,7 +9,9 @@
 //   sim:KEY=VALUE,...      the built-in simulator, streamed without touching the disk; keys:
 //                          world (seed, default 1), run (S0..S3, default S2), condition,
 //                          traffic (seed), frames (maximum), preset (full|small|tiny), cameras
-//                          (0|1), sweep (0|1: motion distortion, per-point times); a build
+//                          (0|1), sweep (0|1: motion distortion, per-point times),
+//                          label_noise (0..3: camera labels as a network's, sim/label_noise.h);
+//                          a build
 //                          without the simulator (SEMSEGMAP_WITH_SIM=OFF)
 //                          says so in one line
 #pragma once
@@ -20,6 +22,7 @@
 
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/odometry/lidar_odometry.h"
+#include "semsegmap/semantics/segmentation_network.h"
 
 namespace semsegmap {
 
@@ -31,9 +34,16 @@ struct DatasetOptions {
   OdometryConfig lidar_odometry;       // the LiDAR odometry's settings, for --odometry lidar
   std::filesystem::path ground_truth;  // --ground-truth FILE: likewise
   std::filesystem::path kitti_calib;   // --kitti-calib: calib.txt for KITTI camera-0 poses
+  // --labels DIR: a label set's images replace the dataset's (datasets/semantic_sources.h).
+  std::filesystem::path labels;
+  // The config's semantics: section; with a model, the network labels pictures that have none.
+  SemanticsConfig semantics;
+  std::filesystem::path class_maps_dir;  // the shipped class maps (config/class_maps)
 };
 
-// Throws std::runtime_error / std::invalid_argument naming the spec and what was wrong.
+// Throws std::runtime_error / std::invalid_argument naming the spec and what was wrong. The
+// network (semantics.model) is loaded and checked against the rig's cameras here, before any
+// frame is read; it is the outermost step, so that odometry never waits for it.
 std::unique_ptr<FrameSource> openDataset(const std::string& spec,
                                          const DatasetOptions& options = {});
 

@@ -1,6 +1,7 @@
 #include "semsegmap/eval/descriptor_eval.h"
 
 #include <chrono>
+#include <limits>
 #include <map>
 
 #include "semsegmap/eval/retrieval.h"
@@ -8,7 +9,10 @@
 namespace semsegmap {
 
 std::vector<CompletenessBand> defaultCompletenessBands() {
-  return {{0.0, 0.3, "<30%"}, {0.3, 0.6, "30-60%"}, {0.6, 0.9, "60-90%"}, {0.9, 1.01, ">=90%"}};
+  return {{0.0, 0.3, "<30%"},
+          {0.3, 0.6, "30-60%"},
+          {0.6, 0.9, "60-90%"},
+          {0.9, std::numeric_limits<double>::infinity(), ">=90%"}};
 }
 
 RetrievalQueries makeRetrievalQueries(const TrainingSet& set, size_t min_observations) {
@@ -18,9 +22,10 @@ RetrievalQueries makeRetrievalQueries(const TrainingSet& set, size_t min_observa
   RetrievalQueries q;
   for (const auto& [key, obs] : by_segment) {
     if (obs.size() < min_observations) continue;
-    size_t final_obs = obs.front();
-    for (size_t i : obs)
-      if (set.observations[i].n_points >= set.observations[final_obs].n_points) final_obs = i;
+    // The final observation is the last one, as in training (learn/finalObservations): it is
+    // the one the segment leaves the local map with, so the one a target map stores. A merge or
+    // split can leave it smaller than an earlier one, whose completeness is then above 1.
+    const size_t final_obs = obs.back();
     const int target = static_cast<int>(q.targets.size());
     q.targets.push_back(final_obs);
     for (size_t i : obs) {

@@ -33,8 +33,8 @@ std::vector<BuiltMap> buildMaps(const LocalizationExperimentConfig& cfg,
                                 const std::vector<std::shared_ptr<Describer>>& describers,
                                 const std::filesystem::path& out,
                                 const ExperimentProgress& progress) {
-  auto source =
-      openDataset(simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset, cfg.max_frames));
+  auto source = openDataset(
+      simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset, cfg.max_frames, cfg.label_noise));
   std::vector<std::unique_ptr<MappingSession>> sessions;
   for (size_t c = 0; c < cfg.configs.size(); ++c) {
     PipelineConfig pc = cfg.configs[c].config;
@@ -118,7 +118,14 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
                  const std::vector<BuiltMap>& maps, const std::filesystem::path& out,
                  const ExperimentProgress& progress) {
   const LocalizationExperimentConfig& cfg = e.config;
-  auto source = openDataset(simulatedRunSpec(cfg.world_seed, run_name, cfg.preset, cfg.max_frames));
+  DatasetOptions options;
+  if (cfg.lidar_odometry) {
+    options.odometry = "lidar";
+    options.lidar_odometry = cfg.odometry;
+  }
+  auto source = openDataset(
+      simulatedRunSpec(cfg.world_seed, run_name, cfg.preset, cfg.max_frames, cfg.label_noise),
+      options);
   std::vector<std::unique_ptr<LocalizationSession>> sessions;
   for (size_t c = 0; c < cfg.configs.size(); ++c)
     sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source->info(),
@@ -214,6 +221,8 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
   j["world_seed"] = e.config.world_seed;
   j["preset"] = e.config.preset;
   j["map_run"] = e.config.map_run;
+  j["label_noise"] = e.config.label_noise;
+  j["query_odometry"] = e.config.lidar_odometry ? "lidar" : "simulated";
   j["correct_m"] = e.config.correct_m;
   j["wrong_m"] = e.config.wrong_m;
   j["recall_window_m"] = e.config.recall_window_m;

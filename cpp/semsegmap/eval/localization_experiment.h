@@ -9,6 +9,7 @@
 
 #include "semsegmap/core/json.h"
 #include "semsegmap/eval/experiment.h"
+#include "semsegmap/odometry/lidar_odometry.h"
 #include "semsegmap/pipeline/modes.h"
 
 namespace semsegmap {
@@ -18,7 +19,13 @@ struct LocalizationExperimentConfig {
   std::string preset = "full";  // sim::worldPreset
   std::string map_run = "S0";
   std::vector<std::string> query_runs = {"S2", "S3"};
-  size_t max_frames = 0;             // per run; 0: all
+  size_t max_frames = 0;  // per run; 0: all
+  // Camera labels of every run as a segmentation network's (sim/label_noise.h): 0 perfect.
+  int label_noise = 0;
+  // The query runs' odometry from LiDAR odometry on their scans (odometry/), with these
+  // settings, instead of the simulator's drifting odometry.
+  bool lidar_odometry = false;
+  OdometryConfig odometry;
   std::vector<NamedConfig> configs;  // compared side by side (semsegmap, segmap)
   double correct_m = 1.0;            // a localization this close counts for recall
   double wrong_m = 5.0;              // a localization farther off is wrong

@@ -6,6 +6,8 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <vector>
 
 namespace semsegmap {
 
@@ -57,8 +59,9 @@ YAML::Node loadConfigRoot(const std::filesystem::path& path) {
   if (!root.IsMap())
     throw std::runtime_error(path.string() + ": expected a mapping at the top level");
   const std::map<std::string, bool> sections = {
-      {"enrichment", true},   {"local_map", true},  {"segmentation", true}, {"descriptor", true},
-      {"localization", true}, {"target_map", true}, {"loop_closure", true}, {"odometry", true}};
+      {"enrichment", true},   {"local_map", true},    {"segmentation", true},
+      {"descriptor", true},   {"localization", true}, {"target_map", true},
+      {"loop_closure", true}, {"odometry", true},     {"semantics", true}};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (!sections.count(key))
@@ -80,6 +83,8 @@ void checkPipelineConfig(const std::filesystem::path& path, const PipelineConfig
   check(lm.voxel_size_m > 0, "local_map.voxel_size_m: must be positive");
   check(lm.radius_m > lm.voxel_size_m, "local_map.radius_m: must exceed the voxel size");
   check(lm.min_points_per_voxel >= 1, "local_map.min_points_per_voxel: must be at least 1");
+  check(lm.dynamic_vote_share >= 0 && lm.dynamic_vote_share < 1,
+        "local_map.dynamic_vote_share: must be in [0, 1)");
   check(sg.d_segment_m > 0, "segmentation.d_segment_m: must be positive");
   check(sg.hue_threshold >= 0 && sg.hue_threshold <= 0.5,
         "segmentation.hue_threshold: must be in [0, 0.5]");
@@ -138,6 +143,74 @@ void readOdometrySection(const std::filesystem::path& path, const YAML::Node& ro
 
 }  // namespace
 
+namespace {
+
+// A path written in a config file is relative to the config file, so that the config works from
+// any directory.
+std::string besideConfig(const std::filesystem::path& config, const std::string& file) {
+  if (file.empty() || std::filesystem::path(file).is_absolute()) return file;
+  return (config.parent_path() / file).lexically_normal().string();
+}
+
+void readSemanticsSection(const std::filesystem::path& path, const YAML::Node& root,
+                          SemanticsConfig& c) {
+  std::string resize, output, order;
+  std::vector<float> mean, stddev;
+  readSection(path, root, "semantics",
+              {{"model", set(c.model)},
+               {"class_map", set(c.class_map)},
+               {"input_width", set(c.input_width)},
+               {"input_height", set(c.input_height)},
+               {"resize", set(resize)},
+               {"mean", set(mean)},
+               {"std", set(stddev)},
+               {"channel_order", set(order)},
+               {"output", set(output)},
+               {"threads", set(c.threads)},
+               {"rate_hz", set(c.rate_hz)},
+               {"tolerance_s", set(c.tolerance_s)},
+               {"replace_dataset_labels", set(c.replace_dataset_labels)}});
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(path.string() + ": semantics." + what);
+  };
+  try {
+    if (!resize.empty()) c.resize = parseResizePolicy(resize);
+  } catch (const std::invalid_argument& e) {
+    fail(std::string("resize: ") + e.what());
+  }
+  try {
+    if (!output.empty()) c.output = parseNetworkOutput(output);
+  } catch (const std::invalid_argument& e) {
+    fail(std::string("output: ") + e.what());
+  }
+  if (!order.empty() && order != "rgb" && order != "bgr")
+    fail("channel_order: expected rgb or bgr, got '" + order + "'");
+  c.bgr = order == "bgr";
+  for (auto [values, key, target] :
+       {std::tuple{&mean, "mean", &c.mean}, std::tuple{&stddev, "std", &c.std}}) {
+    if (values->empty()) continue;
+    if (values->size() != 3) fail(std::string(key) + ": expected 3 numbers (R, G, B)");
+    std::copy(values->begin(), values->end(), target->begin());
+  }
+  for (float s : c.std)
+    if (!(s > 0)) fail("std: must be positive");
+  if ((c.input_width > 0) != (c.input_height > 0) || c.input_width < 0 || c.input_height < 0)
+    fail("input_width, input_height: give both (positive) or neither");
+  if (c.rate_hz < 0 || c.tolerance_s < 0) fail("rate_hz, tolerance_s: must not be negative");
+  c.model = besideConfig(path, c.model);
+  const std::filesystem::path map(c.class_map);
+  if (map.has_parent_path() || map.extension() == ".yaml")
+    c.class_map = besideConfig(path, c.class_map);
+}
+
+}  // namespace
+
+SemanticsConfig loadSemanticsConfig(const std::filesystem::path& path) {
+  SemanticsConfig c;
+  readSemanticsSection(path, loadConfigRoot(path), c);
+  return c;
+}
+
 OdometryConfig loadOdometryConfig(const std::filesystem::path& path) {
   OdometryConfig c;
   readOdometrySection(path, loadConfigRoot(path), c);
@@ -152,8 +225,11 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"occlusion_tolerance_m", set(c.enrichment.occlusion_tolerance_m)},
                {"occlusion_tolerance_rel", set(c.enrichment.occlusion_tolerance_rel)}});
   auto& lm = c.local_map;
+  std::string dynamic_removal;
   readSection(path, root, "local_map",
               {{"voxel_size_m", set(lm.voxel_size_m)},
+               {"dynamic_removal", set(dynamic_removal)},
+               {"dynamic_vote_share", set(lm.dynamic_vote_share)},
                {"radius_m", set(lm.radius_m)},
                {"min_points_per_voxel", set(lm.min_points_per_voxel)},
                {"remove_dynamic_classes", set(lm.remove_dynamic_classes)},
@@ -163,6 +239,11 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"ground_cell_size_m", set(lm.ground.cell_size_m)},
                {"ground_neighbourhood_cells", set(lm.ground.neighbourhood_cells)},
                {"ground_height_above_m", set(lm.ground.height_above_m)}});
+  try {
+    if (!dynamic_removal.empty()) lm.dynamic_removal = parseDynamicRemoval(dynamic_removal);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(path.string() + ": local_map.dynamic_removal: " + e.what());
+  }
   auto& sg = c.segmentation;
   readSection(path, root, "segmentation",
               {{"d_segment_m", set(sg.d_segment_m)},
@@ -177,10 +258,7 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
   auto& d = c.descriptor;
   readSection(path, root, "descriptor",
               {{"kind", set(d.kind)}, {"model", set(d.model)}, {"batch", set(d.batch)}});
-  // A model path in a config file is relative to the config file, so that the config works
-  // from any directory.
-  if (!d.model.empty() && std::filesystem::path(d.model).is_relative())
-    d.model = (path.parent_path() / d.model).lexically_normal().string();
+  d.model = besideConfig(path, d.model);
   auto& loc = c.localization;
   readSection(path, root, "localization",
               {{"k", set(loc.localizer.index.k)},
@@ -204,6 +282,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
   checkPipelineConfig(path, c);
   OdometryConfig odometry;  // checked here too, so that a typo fails every command
   readOdometrySection(path, root, odometry);
+  SemanticsConfig semantics;
+  readSemanticsSection(path, root, semantics);
   return c;
 }
 

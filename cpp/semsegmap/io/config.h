@@ -6,6 +6,7 @@
 
 #include "semsegmap/odometry/lidar_odometry.h"
 #include "semsegmap/pipeline/pipeline_config.h"
+#include "semsegmap/semantics/segmentation_network.h"
 
 namespace semsegmap {
 
@@ -15,5 +16,9 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path);
 // The `odometry:` section of the same file (LiDAR odometry, odometry/lidar_odometry.h): the
 // defaults when it has none. Same errors.
 OdometryConfig loadOdometryConfig(const std::filesystem::path& path);
+
+// The `semantics:` section (the segmentation network, semantics/segmentation_network.h): the
+// model and a class map file relative to the config file; no model when the section is absent.
+SemanticsConfig loadSemanticsConfig(const std::filesystem::path& path);
 
 }  // namespace semsegmap

@@ -143,9 +143,7 @@ DatasetReader::DatasetReader(const fs::path& dir) : dir_(dir) {
 }
 
 Frame DatasetReader::frame(size_t i) {
-  if (i >= rows_.size())
-    throw std::out_of_range(dir_.string() + ": frame " + std::to_string(i) +
-                            " requested, the dataset has " + std::to_string(rows_.size()));
+  if (i >= rows_.size()) throwFrameOutOfRange(dir_.string(), i, rows_.size());
   const Row& row = rows_[i];
   Frame frame;
   frame.index = row.index;

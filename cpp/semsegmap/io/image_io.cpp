@@ -64,19 +64,28 @@ Image readPng(const std::filesystem::path& path) {
   }
 }
 
-Image readColorImage(const std::filesystem::path& path) {
-  const std::string bytes = readFileBytes(path);
+Image decodeColorImage(const uint8_t* data, size_t size, const std::string& what) {
   cv::Mat decoded;
   try {
-    const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data()));
-    decoded = cv::imdecode(buffer, cv::IMREAD_COLOR);  // BGR, 8 bit, grey expanded
+    if (size > 0) {
+      const cv::Mat buffer(1, static_cast<int>(size), CV_8U, const_cast<uint8_t*>(data));
+      decoded = cv::imdecode(buffer, cv::IMREAD_COLOR);  // BGR, 8 bit, grey expanded
+    }
   } catch (const cv::Exception& e) {
-    fail(path, "corrupt image (" + e.err + ")");
+    throw std::runtime_error(what + ": corrupt image (" + e.err + ")");
   }
-  if (decoded.empty()) fail(path, "not a readable PNG or JPEG image");
+  if (decoded.empty())
+    throw std::runtime_error(what + ": not a readable PNG or JPEG image (" + std::to_string(size) +
+                             " bytes)");
   cv::Mat rgb;
   cv::cvtColor(decoded, rgb, cv::COLOR_BGR2RGB);
   return fromMat(rgb);
+}
+
+Image readColorImage(const std::filesystem::path& path) {
+  const std::string bytes = readFileBytes(path);
+  return decodeColorImage(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(),
+                          path.string());
 }
 
 void writePng(const std::filesystem::path& path, const Image& image) {

@@ -225,11 +225,6 @@ Frame kittiScanFrame(size_t index, double timestamp_s, const std::filesystem::pa
   return f;
 }
 
-void throwFrameOutOfRange(const std::string& dataset, size_t index, size_t frames) {
-  throw std::out_of_range(dataset + ": frame " + std::to_string(index) + " out of range (" +
-                          std::to_string(frames) + " frames)");
-}
-
 // One line of numbers per entry; blank lines are skipped, but every other line counts so that
 // line n stays frame n.
 std::vector<std::vector<double>> readNumberLines(const std::filesystem::path& path,

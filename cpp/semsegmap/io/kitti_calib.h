@@ -87,8 +87,6 @@ std::vector<Pose> readKittiPoses(const std::filesystem::path& path);
 // LiDAR poses in the first LiDAR frame: T_world_lidar = Tr^-1 * T_world_cam0 * Tr.
 std::vector<Pose> kittiLidarPoses(const std::vector<Pose>& camera0_poses, const Pose& Tr);
 
-[[noreturn]] void throwFrameOutOfRange(const std::string& dataset, size_t index, size_t frames);
-
 // KITTI raw's rectified camera `index` (2 = left color) as our Camera, such that
 // camera.project(camera.T_camera_lidar * X) equals the devkit's
 // P_rect_0i * R_rect_00 * [R|T]_velo_to_cam * X for every LiDAR point X. P_rect_0i = K [I | K^-1 p]

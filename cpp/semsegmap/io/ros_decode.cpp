@@ -1,5 +1,6 @@
 #include "semsegmap/io/ros_decode.h"
 
+#include "semsegmap/io/image_io.h"
 #include "semsegmap/io/point_fields.h"
 
 #include <algorithm>
@@ -9,7 +10,6 @@
 #include <stdexcept>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace semsegmap::rosmsg {
@@ -115,18 +115,8 @@ semsegmap::Image decodeImage(const Image& msg, const std::string& where) {
 }
 
 semsegmap::Image decodeCompressedImage(const CompressedImage& msg, const std::string& where) {
-  cv::Mat bgr;
-  if (!msg.data.empty()) {
-    const cv::Mat bytes(1, static_cast<int>(msg.data.size()), CV_8UC1,
-                        const_cast<uint8_t*>(msg.data.data()));
-    bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);  // grey images come back as grey BGR
-  }
-  if (bgr.empty())
-    fail(where, "compressed image (format '" + msg.format + "', " +
-                    std::to_string(msg.data.size()) + " bytes) does not decode as JPEG or PNG");
-  cv::Mat rgb;
-  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-  return fromRgbMat(rgb);
+  return decodeColorImage(msg.data.data(), msg.data.size(),
+                          where + ": compressed image (format '" + msg.format + "')");
 }
 
 namespace {

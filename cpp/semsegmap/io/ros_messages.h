@@ -25,18 +25,9 @@ struct Header {
   std::string frame_id;
 };
 
-// sensor_msgs/PointField; the datatype constants are those of the message definition.
+// sensor_msgs/PointField. `datatype` is kept as read: its numbering is FieldType's
+// (io/point_fields.h), which checks it when the points are decoded.
 struct PointField {
-  enum Type : uint8_t {
-    kInt8 = 1,
-    kUint8 = 2,
-    kInt16 = 3,
-    kUint16 = 4,
-    kInt32 = 5,
-    kUint32 = 6,
-    kFloat32 = 7,
-    kFloat64 = 8
-  };
   std::string name;
   uint32_t offset = 0;
   uint8_t datatype = 0;

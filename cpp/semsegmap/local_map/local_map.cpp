@@ -37,10 +37,22 @@ LocalMap::LocalMap(const LocalMapConfig& config, const ClassTable& classes) : co
   if (!(config.radius_m > 0)) throw std::invalid_argument("local_map.radius_m must be positive");
   if (config.min_points_per_voxel < 1)
     throw std::invalid_argument("local_map.min_points_per_voxel must be at least 1");
+  if (!(config.dynamic_vote_share >= 0 && config.dynamic_vote_share < 1))
+    throw std::invalid_argument("local_map.dynamic_vote_share must be in [0, 1)");
+  const bool by_point = config.dynamic_removal == DynamicRemoval::kPoint;
   drop_class_.assign(1 << 16, 0);
-  for (const auto& c : classes.classes())
-    drop_class_[c.id] =
-        (config.remove_dynamic_classes && c.dynamic) || (config.remove_ground_classes && c.ground);
+  dynamic_class_.assign(1 << 16, 0);
+  for (const auto& c : classes.classes()) {
+    const bool dynamic = config.remove_dynamic_classes && c.dynamic;
+    drop_class_[c.id] = (dynamic && by_point) || (config.remove_ground_classes && c.ground);
+    dynamic_class_[c.id] = dynamic && !by_point;
+  }
+}
+
+DynamicRemoval parseDynamicRemoval(const std::string& name) {
+  if (name == "point") return DynamicRemoval::kPoint;
+  if (name == "voxel") return DynamicRemoval::kVoxel;
+  throw std::invalid_argument("expected point or voxel, got '" + name + "'");
 }
 
 Eigen::Vector3i LocalMap::voxelIndex(const Eigen::Vector3f& p) const {
@@ -64,6 +76,8 @@ LocalMapUpdate LocalMap::update(const EnrichedCloud& scan, const Pose& T_map_lid
   const Eigen::Vector3f t = T_map_lidar.translation().cast<float>();
   const Eigen::Vector2f center = robot_xy.cast<float>();
   const float r2 = static_cast<float>(config_.radius_m * config_.radius_m);
+  ++scan_;
+  std::vector<VoxelKey> pending;
 
   for (size_t k = 0; k < scan.size(); ++k) {
     const EnrichedPoint& q = scan[k];
@@ -93,14 +107,25 @@ LocalMapUpdate LocalMap::update(const EnrichedCloud& scan, const Pose& T_map_lid
       v.saturation += (q.s - v.saturation) * inv_n;
       v.value += (q.v - v.value) * inv_n;
     }
-    v.classes.add(q.class_id);
+    if (dynamic_class_[q.class_id])
+      ++v.n_dynamic;
+    else
+      v.classes.add(q.class_id);
     if (q.instance_id != 0) v.instances.add(q.instance_id);
     ++out.points_inserted;
-    if (!v.active && v.n_points >= config_.min_points_per_voxel) {
-      v.active = true;
-      ++active_count_;
-      out.newly_active.push_back(key);
+    // Considered for activation once the scan is in, when its votes are counted; in the order
+    // voxels reach the minimum, so that without dynamic votes the order is that of the points.
+    if (!v.active && v.pending_scan != scan_ && v.n_points >= config_.min_points_per_voxel) {
+      v.pending_scan = scan_;
+      pending.push_back(key);
     }
+  }
+  for (VoxelKey key : pending) {
+    Voxel& v = voxels_.at(key);
+    if (v.n_dynamic > config_.dynamic_vote_share * v.n_points) continue;
+    v.active = true;
+    ++active_count_;
+    out.newly_active.push_back(key);
   }
 
   // The cylinder follows the robot: whatever is now outside it is forgotten.

@@ -4,6 +4,7 @@
 // and each update reports the voxels that became active and those that left the cylinder.
 #pragma once
 
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -15,12 +16,25 @@
 
 namespace semsegmap {
 
+// How points of dynamic classes (the class table's dynamic flag: car, person) leave the map.
+enum class DynamicRemoval {
+  kPoint,  // each such point is dropped: the mislabelled edges of a moving truck survive
+  kVoxel,  // a voxel is dropped when its class votes say dynamic by majority
+};
+DynamicRemoval parseDynamicRemoval(const std::string& name);  // point | voxel
+
 struct LocalMapConfig {
   double voxel_size_m = 0.1;
   double radius_m = 50.0;
   uint32_t min_points_per_voxel = 1;
   bool remove_dynamic_classes = true;  // person, car: the class table's dynamic flag
-  bool remove_ground_classes = true;   // road, sidewalk, terrain: the ground flag
+  // A real network labels the edges of a car as the wall behind it and the other way round; by
+  // voxel, a voxel whose points are more than dynamic_vote_share dynamic is never made active
+  // (its static minority goes with it), and the dynamic minority of a static voxel counts in
+  // its geometry and colour but not its class.
+  DynamicRemoval dynamic_removal = DynamicRemoval::kVoxel;
+  double dynamic_vote_share = 0.5;
+  bool remove_ground_classes = true;  // road, sidewalk, terrain: the ground flag
   // Points no camera saw (class unknown) in a scan that does carry semantics: without a class
   // they cannot be filtered as ground or dynamic, and one stray ground patch glues every segment
   // it touches into one.
@@ -62,7 +76,9 @@ class LocalMap {
 
   LocalMapConfig config_;
   int tile_voxels_ = 20;
-  std::vector<uint8_t> drop_class_;  // by class id: dynamic or ground, per the config
+  std::vector<uint8_t> drop_class_;     // by class id: dropped point by point, per the config
+  std::vector<uint8_t> dynamic_class_;  // by class id: voted on by voxel, per the config
+  uint32_t scan_ = 0;                   // updates so far: marks the voxels pending this one
   std::unordered_map<VoxelKey, Voxel> voxels_;
   // Voxels grouped by 2-D tile: moving the cylinder tests whole tiles and only looks at single
   // voxels in the tiles its rim crosses, instead of sweeping every voxel every frame.

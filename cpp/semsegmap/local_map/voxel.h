@@ -42,6 +42,8 @@ struct Voxel {
   float hue_cos = 0, hue_sin = 0, saturation = 0, value = 0;
   Votes<ClassId, 4> classes;
   Votes<uint16_t, 3> instances;  // ground truth, when known
+  uint32_t n_dynamic = 0;        // points of dynamic classes (counted, not voted: DynamicRemoval)
+  uint32_t pending_scan = 0;     // the update that last considered it for activation (1-based)
   bool active = false;
 
   float hue() const;  // in [0, 1)

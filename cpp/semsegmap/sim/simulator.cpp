@@ -23,7 +23,9 @@ Simulator::Simulator(const SimConfig& config)
   trajectory_ = makeTrajectory(world_->roads, config.run, config_.trajectory, config_.odometry,
                                hashKeys(config.world.seed, static_cast<uint64_t>(config.run)));
   info_.name = "sim world " + std::to_string(config.world.seed) + " run " + runName(config.run) +
-               " " + lighting_.name + " traffic " + std::to_string(traffic_seed_);
+               " " + lighting_.name + " traffic " + std::to_string(traffic_seed_) +
+               (config.label_noise > 0 ? " label noise " + std::to_string(config.label_noise) : "");
+  label_noise_ = labelNoiseOfLevel(config.label_noise);
   info_.rig = config_.rig;
   if (!config_.render_cameras) info_.rig.cameras.clear();
   info_.classes = ClassTable::Default();
@@ -76,9 +78,7 @@ LidarScan Simulator::sweepLidar(size_t index, uint64_t seed) const {
 }
 
 Frame Simulator::frame(size_t index) {
-  if (index >= size())
-    throw std::out_of_range("simulator: frame " + std::to_string(index) + " of " +
-                            std::to_string(size()));
+  if (index >= size()) throwFrameOutOfRange(info_.name, index, size());
   Frame f;
   f.index = index;
   f.timestamp_s = trajectory_.timestamps_s[index];
@@ -100,6 +100,8 @@ Frame Simulator::frame(size_t index) {
     const Camera& cam = info_.rig.cameras[c];
     CameraRender r = renderCamera(*scene_, cam, T_world_lidar * cam.T_camera_lidar.inverse(),
                                   lighting_, hashKeys(seed, c + 1));
+    if (config_.label_noise > 0)
+      r.label = applyLabelNoise(r.label, label_noise_, hashKeys(seed, c + 1, 0x6e6f697365));
     f.cameras.push_back({std::move(r.rgb), std::move(r.label)});
   }
   return f;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "semsegmap/core/frame_source.h"
+#include "semsegmap/sim/label_noise.h"
 #include "semsegmap/sim/lidar_sim.h"
 #include "semsegmap/sim/lighting.h"
 #include "semsegmap/sim/ray_scene.h"
@@ -30,6 +31,9 @@ struct SimConfig {
   // one turn per frame) while the vehicle drives on, each point in the LiDAR frame of its own
   // time, Frame::point_times filled. Off: every column at the frame's pose, as before.
   bool lidar_sweep = false;
+  // Imperfect camera labels (sim/label_noise.h): 0 perfect, up to 3 worse than a good Cityscapes
+  // model. The LiDAR points' ground truth stays exact.
+  int label_noise = 0;
   double agent_clearance_m = 6.0;
 };
 
@@ -58,6 +62,7 @@ class Simulator : public FrameSource {
   Trajectory trajectory_;
   Lighting lighting_;
   DatasetInfo info_;
+  LabelNoise label_noise_;
 };
 
 }  // namespace semsegmap::sim
