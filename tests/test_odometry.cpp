@@ -15,6 +15,7 @@
 #include "semsegmap/eval/odometry_metrics.h"
 #include "semsegmap/eval/odometry_run.h"
 #include "semsegmap/io/config.h"
+#include "semsegmap/io/kitti_calib.h"
 #include "semsegmap/odometry/lidar_odometry.h"
 #include "semsegmap/odometry/motion.h"
 #if SEMSEGMAP_TEST_PCL
@@ -474,30 +475,6 @@ TEST(OdometryRun, ATinySimulatedRunWithMotionDistortion) {
 const std::filesystem::path kKittiSparse =
     std::filesystem::path(SEMSEGMAP_SHARED_DATA) / "kitti_odometry_00_sparse";
 
-// Line `index` (0-based) of a KITTI poses file as a LiDAR pose: Tr^-1 * P * Tr.
-Pose kittiLidarPose(const std::filesystem::path& poses, size_t index, const Pose& Tr) {
-  std::ifstream in(poses);
-  std::string line;
-  for (size_t i = 0; i <= index; ++i)
-    if (!std::getline(in, line)) throw std::runtime_error(poses.string() + ": too few poses");
-  std::istringstream row(line);
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) row >> m(r, c);
-  Pose P;
-  P.matrix() = m;
-  return Tr.inverse() * P * Tr;
-}
-
-std::vector<LidarPoint> loadKittiBin(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::vector<LidarPoint> points;
-  LidarPoint p;
-  while (in.read(reinterpret_cast<char*>(&p), sizeof(p))) points.push_back(p);
-  if (points.empty()) throw std::runtime_error(path.string() + ": no points");
-  return points;
-}
-
 // The target (3 cm and 0.1 deg a frame) where the sample's scans and ground truth agree: the two
 // consecutive pairs of the sparse set driven at cruising speed, frames 94-95 and 198-199, each
 // registered from a standing start (no velocity to predict from). At the start of the sequence
@@ -506,19 +483,8 @@ TEST(OdometryOnRealScans, Kitti00ConsecutivePairsMeetTheTarget) {
   if (!std::filesystem::exists(kKittiSparse / "poses.txt"))
     GTEST_SKIP() << "no real KITTI sample (" << kKittiSparse.string()
                  << "): ../shared/data is not beside this checkout";
-  Pose Tr = Pose::Identity();
-  {
-    std::ifstream in(kKittiSparse / "calib.txt");
-    std::string line;
-    while (std::getline(in, line))
-      if (line.rfind("Tr:", 0) == 0) {
-        std::istringstream row(line.substr(3));
-        Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 4; ++c) row >> m(r, c);
-        Tr.matrix() = m;
-      }
-  }
+  const Pose Tr = KittiCalibFile(kKittiSparse / "calib.txt").transform3x4("Tr");
+  const std::vector<Pose> gt = kittiLidarPoses(readKittiPoses(kKittiSparse / "poses.txt"), Tr);
   double t_sum = 0, r_sum = 0;
   for (size_t first : {94, 198}) {
     LidarOdometry odom;
@@ -526,11 +492,10 @@ TEST(OdometryOnRealScans, Kitti00ConsecutivePairsMeetTheTarget) {
     for (size_t i : {first, first + 1}) {
       char name[24];
       std::snprintf(name, sizeof(name), "velodyne/%06zu.bin", i);
-      const OdometryResult r = odom.registerFrame(loadKittiBin(kKittiSparse / name), {}, 0.1 * i);
-      est.push_back(r.T_odom_lidar);
+      const Frame scan = kittiScanFrame(i, 0.1 * i, kKittiSparse / name);
+      est.push_back(odom.registerFrame(scan.points, {}, scan.timestamp_s).T_odom_lidar);
     }
-    const Pose d_gt = kittiLidarPose(kKittiSparse / "poses.txt", first, Tr).inverse() *
-                      kittiLidarPose(kKittiSparse / "poses.txt", first + 1, Tr);
+    const Pose d_gt = gt[first].inverse() * gt[first + 1];
     const Pose d_est = est[0].inverse() * est[1];
     std::printf("KITTI 00 frames %zu-%zu: %.4f m, %.4f deg (moved %.3f m)\n", first, first + 1,
                 translationError(d_est, d_gt), rotationErrorDeg(d_est, d_gt),

@@ -39,7 +39,8 @@ size_t writeFrameLabels(const Frame& frame, size_t index, const DatasetInfo& inf
 
 int runLabel(const CliArgs& a) {
   const std::filesystem::path config = a.get("config"), out = a.get("out");
-  if (loadSemanticsConfig(config).model.empty())
+  const std::string model = loadSemanticsConfig(config).model;
+  if (model.empty())
     throw std::runtime_error(config.string() +
                              ": semantics.model: empty; label runs the segmentation network "
                              "that this section names");
@@ -62,7 +63,7 @@ int runLabel(const CliArgs& a) {
   set.frames = source->size();
   set.cameras = info.rig.cameras.size();
   set.dataset = a.get("dataset");
-  set.model = loadSemanticsConfig(config).model;
+  set.model = model;
   writeLabelSetInfo(out, set);
 
   const LabelingStats& s = labelerOf(*source)->stats();
