@@ -101,7 +101,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"map", "poses", "odometry"}},
     {"train",
      {"descriptor", "dataset", "out", "epochs", "batch", "threads", "config", "max-frames", "cache",
-      "anchors-per-epoch", "lr", "seed", "points", "history"},
+      "anchors-per-epoch", "lr", "seed", "confused-sections", "points", "history"},
      {"world-seed", "map"}},
     {"demo", {"out", "world-seed", "preset", "max-frames"}, {"configs", "dataset"}},
     {"eval segmentation",

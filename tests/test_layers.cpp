@@ -35,7 +35,7 @@ std::map<std::string, std::set<std::string>> makeTable() {
       {"local_map", {"core"}},
       {"segment", {"core", "local_map"}},
       {"describe", {"core", "local_map", "segment"}},
-      {"localize", {"core"}},
+      {"localize", {"core", "odometry"}},  // pose refinement registers with its ICP
       {"graph", {"core"}},
       {"odometry", {"core"}},
       {"pipeline", stages},

@@ -167,6 +167,45 @@ TEST(Augment, AugmentIsPureAndKeepsPoints) {
   for (size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(cloud[i].x, copy[i].x);
 }
 
+TEST(Augment, ConfusedSectionTakesTheClassANetworkConfusesItWith) {
+  EnrichedCloud cloud = randomCloud(4000, 8, cls::kFence);
+  for (size_t i = 0; i < cloud.size(); i += 2) cloud[i].class_id = cls::kPole;
+  for (size_t i = 1; i < cloud.size(); i += 4) cloud[i].class_id = cls::kCar;
+  std::mt19937 rng(8);
+  const EnrichedCloud out = confuseSection(cloud, 0.3, rng);
+  ASSERT_EQ(out.size(), cloud.size()) << "relabelled, not removed";
+  size_t changed = 0;
+  std::set<ClassId> fence_became, pole_became;
+  for (size_t i = 0; i < out.size(); ++i) {
+    EXPECT_EQ(out[i].x, cloud[i].x);
+    if (out[i].class_id == cloud[i].class_id) continue;
+    ++changed;
+    ASSERT_NE(cloud[i].class_id, cls::kCar) << "a car has no partner class";
+    (cloud[i].class_id == cls::kFence ? fence_became : pole_became).insert(out[i].class_id);
+  }
+  // The cars beyond the plane keep their class: about 3/4 of 30 % of the points change.
+  EXPECT_NEAR(static_cast<double>(changed), 0.75 * 1200.0, 120.0);
+  ASSERT_EQ(fence_became.size(), 1u) << "one partner for the whole section";
+  EXPECT_TRUE(*fence_became.begin() == cls::kBuilding || *fence_became.begin() == cls::kVegetation);
+  EXPECT_EQ(pole_became, fence_became) << "a missed pole takes the class behind it";
+}
+
+TEST(Augment, ConfusedSectionsOffKeepTheRecipeBeforeThem) {
+  const EnrichedCloud cloud = randomCloud(1000, 9);
+  AugmentConfig with;
+  with.confused_section_probability = 1.0;
+  std::mt19937 a(9), b(9);
+  const EnrichedCloud off = augment(cloud, AugmentConfig{}, a);
+  const EnrichedCloud on = augment(cloud, with, b);
+  ASSERT_EQ(off.size(), on.size()) << "the section is relabelled after the geometry";
+  size_t differ = 0;
+  for (size_t i = 0; i < off.size(); ++i) {
+    EXPECT_EQ(off[i].x, on[i].x) << "the same draws up to the confused section";
+    differ += off[i].class_id != on[i].class_id;
+  }
+  EXPECT_GT(differ, 0u) << "building points have a partner class (fence)";
+}
+
 // ---- Pairs, split, retrieval -------------------------------------------------------------------
 
 TEST(TrainingData, PositivesShareALandmarkNegativesDoNot) {

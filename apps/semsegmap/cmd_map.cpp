@@ -75,7 +75,8 @@ const CommandSpec& mapCommand() {
               {"poses", Value::kText, "gt|odom|slam", "",
                "poses the map is built with (default: gt when the data has them, else odom)"},
               maxFramesOption(),
-              {"points", Value::kCount, "N", "0", "points kept per segment for pictures, 0..65535"},
+              {"points", Value::kCount, "N", "0",
+               "points kept per segment, for pictures and pose refinement (refinement:), 0..65535"},
               {"float32", Value::kFlag, "", "", "store descriptors as float32 instead of float16"},
           }),
       kDatasetNotes, runMap};

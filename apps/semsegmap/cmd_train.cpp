@@ -143,6 +143,13 @@ TrainConfig trainConfig(const CliArgs& a) {
   if (a.has("lr")) config.learning_rate = a.getNumber("lr");
   if (a.has("anchors-per-epoch")) config.anchors_per_epoch = a.getCount("anchors-per-epoch");
   if (a.has("seed")) config.seed = a.getCount("seed");
+  if (a.has("confused-sections")) {
+    const double p = a.getNumber("confused-sections");
+    if (!(p >= 0 && p <= 1))
+      throw std::invalid_argument("--confused-sections: " + a.get("confused-sections") +
+                                  " is not a probability in [0, 1]");
+    config.augmentation.confused_section_probability = p;
+  }
   validateNetConfig(config.net);  // before the long extraction, not after it
   return config;
 }
@@ -229,6 +236,13 @@ const CommandSpec& trainCommand() {
           {"seed", Value::kCount, "N", "",
            "seed of weights, sampling and augmentation " +
                shown([](const TrainConfig& c) { return c.seed; })},
+          {"confused-sections", Value::kNumber, "P", "",
+           "probability that a training observation gets a planar section of up to half its "
+           "points relabelled as a segmentation network confuses them (fence/building/"
+           "vegetation, terrain/sidewalk, missed poles) " +
+               shown([](const TrainConfig& c) {
+                 return c.augmentation.confused_section_probability;
+               })},
           {"points", Value::kPositive, "N", "",
            "points a segment is subsampled to " +
                shown([](const TrainConfig& c) { return c.net.num_points; })},

@@ -67,4 +67,31 @@ bool ClassTable::operator==(const ClassTable& other) const {
   return true;
 }
 
+namespace cls {
+
+ClassId confusionPartner(ClassId c, bool pick) {
+  switch (c) {
+    case kFence:
+      return pick ? kBuilding : kVegetation;
+    case kBuilding:
+      return kFence;
+    case kVegetation:
+      return kFence;
+    case kTerrain:
+      return kSidewalk;
+    case kSidewalk:
+      return kTerrain;
+    case kRoof:
+      return kBuilding;
+    default:
+      return c;
+  }
+}
+
+bool isThin(ClassId c) {
+  return c == kPole || c == kTrafficSign || c == kTrunk;
+}
+
+}  // namespace cls
+
 }  // namespace semsegmap

@@ -37,6 +37,15 @@ constexpr ClassId kCar = 11;
 constexpr ClassId kPerson = 12;
 constexpr ClassId kOther = 13;
 constexpr ClassId kSky = 14;
+
+// How segmentation networks are wrong about the default table, shared by the simulator's label
+// noise and the descriptors' training augmentation so that both mimic the same errors. The
+// class a confused region takes: walls, fences and hedges, terrain and sidewalks, roofs and
+// walls are what networks mix up; `pick` chooses between two partners. A class without a
+// partner is returned as it is.
+ClassId confusionPartner(ClassId c, bool pick);
+// Poles, signs and trunks: what a network misses and labels as what is behind it.
+bool isThin(ClassId c);
 }  // namespace cls
 
 class ClassTable {

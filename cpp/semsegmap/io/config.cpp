@@ -59,9 +59,9 @@ YAML::Node loadConfigRoot(const std::filesystem::path& path) {
   if (!root.IsMap())
     throw std::runtime_error(path.string() + ": expected a mapping at the top level");
   const std::map<std::string, bool> sections = {
-      {"enrichment", true},   {"local_map", true},    {"segmentation", true},
-      {"descriptor", true},   {"localization", true}, {"target_map", true},
-      {"loop_closure", true}, {"odometry", true},     {"semantics", true}};
+      {"enrichment", true},   {"local_map", true},  {"segmentation", true}, {"descriptor", true},
+      {"localization", true}, {"target_map", true}, {"loop_closure", true}, {"odometry", true},
+      {"semantics", true},    {"refinement", true}};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (!sections.count(key))
@@ -102,6 +102,12 @@ void checkPipelineConfig(const std::filesystem::path& path, const PipelineConfig
   check(loc.every_n_frames >= 1, "localization.every_n_frames: must be at least 1");
   check(c.target_map.duplicate_distance_m >= 0,
         "target_map.duplicate_distance_m: must not be negative");
+  const auto& rf = loc.refinement;
+  check(rf.max_points_per_segment >= 1, "refinement.max_points_per_segment: must be at least 1");
+  check(rf.fine_distance_m > 0 && rf.coarse_distance_m >= rf.fine_distance_m,
+        "refinement: need 0 < fine_distance_m <= coarse_distance_m");
+  check(rf.kernel_scale_m > 0, "refinement.kernel_scale_m: must be positive");
+  check(rf.max_correction_m > 0, "refinement.max_correction_m: must be positive");
   check(lc.exclude_recent_m >= 0, "loop_closure.exclude_recent_m: must not be negative");
 }
 
@@ -267,6 +273,15 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"min_inliers", set(loc.localizer.verification.min_inliers)},
                {"min_local_segments", set(loc.localizer.min_local_segments)},
                {"every_n_frames", set(loc.every_n_frames)}});
+  auto& rf = loc.refinement;
+  readSection(path, root, "refinement",
+              {{"enabled", set(rf.enabled)},
+               {"max_points_per_segment", set(rf.max_points_per_segment)},
+               {"coarse_distance_m", set(rf.coarse_distance_m)},
+               {"fine_distance_m", set(rf.fine_distance_m)},
+               {"kernel_scale_m", set(rf.kernel_scale_m)},
+               {"max_correction_m", set(rf.max_correction_m)},
+               {"min_correspondences", set(rf.min_correspondences)}});
   readSection(path, root, "target_map",
               {{"duplicate_distance_m", set(c.target_map.duplicate_distance_m)},
                {"max_points_per_segment", set(c.target_map.max_points_per_segment)}});

@@ -9,7 +9,9 @@ namespace semsegmap {
 
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
-    out << "frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,rotation_error_deg\n";
+    // refinement_m: how far pose refinement moved the pose; empty where it was not applied.
+    out << "frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,rotation_error_deg,"
+           "refinement_m\n";
     char line[512];
     for (const LocalizationRecord& r : run.localizations) {
       const auto v = toXyzQuat(r.T_map_base);
@@ -20,10 +22,17 @@ void writeLocalizationsCsv(const std::filesystem::path& path, const Localization
       if (r.T_world_base) {
         std::snprintf(line, sizeof(line), ",%.4f,%.4f", r.translation_error_m,
                       r.rotation_error_deg);
-        out << line << '\n';
+        out << line;
       } else {
-        out << ",,\n";
+        out << ",,";
       }
+      if (r.refined) {
+        std::snprintf(line, sizeof(line), ",%.4f", r.refinement_correction_m);
+        out << line;
+      } else {
+        out << ',';
+      }
+      out << '\n';
     }
   });
 }
@@ -58,6 +67,8 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   j["n_localizations"] = s.localizations;
   j["n_error_below_1m"] = s.below_1m;
   j["n_error_below_5m"] = s.below_5m;
+  j["n_refined"] = std::count_if(run.localizations.begin(), run.localizations.end(),
+                                 [](const LocalizationRecord& r) { return r.refined; });
   j["mean_translation_error_m"] = s.mean_translation_error_m;
   j["mean_rotation_error_deg"] = s.mean_rotation_error_deg;
   j["fps"] = run.stats.fps();

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
+
+#include "semsegmap/core/class_table.h"
 
 namespace semsegmap {
 
@@ -82,8 +85,12 @@ EnrichedCloud cutByPlane(const EnrichedCloud& cloud, const Eigen::Vector3f& norm
   return out;
 }
 
-EnrichedCloud cutSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng) {
-  if (cloud.empty() || fraction <= 0) return cloud;
+namespace {
+
+// Which points lie beyond a plane of random direction placed so that about `fraction` of them
+// do; at least one point stays on the near side.
+std::vector<bool> beyondRandomPlane(const EnrichedCloud& cloud, double fraction,
+                                    std::mt19937& rng) {
   // A direction uniform on the sphere.
   std::normal_distribution<float> g(0.0f, 1.0f);
   Eigen::Vector3f n(g(rng), g(rng), g(rng));
@@ -92,17 +99,41 @@ EnrichedCloud cutSection(const EnrichedCloud& cloud, double fraction, std::mt199
   const Eigen::Vector3f c = centroidOf(cloud);
   std::vector<float> d(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) d[i] = n.dot(position(cloud[i]) - c);
-  // The plane sits at the (1 - fraction) quantile of the projections; ties on it survive.
+  // The plane sits at the (1 - fraction) quantile of the projections; ties on it stay.
   const size_t keep = std::max<size_t>(
       1, cloud.size() - static_cast<size_t>(std::round(std::clamp(fraction, 0.0, 1.0) *
                                                        static_cast<double>(cloud.size()))));
   std::vector<float> sorted = d;
   std::nth_element(sorted.begin(), sorted.begin() + (keep - 1), sorted.end());
   const float offset = sorted[keep - 1];
+  std::vector<bool> beyond(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) beyond[i] = d[i] > offset;
+  return beyond;
+}
+
+}  // namespace
+
+EnrichedCloud cutSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng) {
+  if (cloud.empty() || fraction <= 0) return cloud;
+  const std::vector<bool> beyond = beyondRandomPlane(cloud, fraction, rng);
   EnrichedCloud out;
-  out.reserve(keep);
+  out.reserve(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i)
-    if (d[i] <= offset) out.push_back(cloud[i]);
+    if (!beyond[i]) out.push_back(cloud[i]);
+  return out;
+}
+
+EnrichedCloud confuseSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng) {
+  if (cloud.empty() || fraction <= 0) return cloud;
+  const std::vector<bool> beyond = beyondRandomPlane(cloud, fraction, rng);
+  const bool pick = std::bernoulli_distribution(0.5)(rng);
+  EnrichedCloud out = cloud;
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (!beyond[i]) continue;
+    const ClassId c = out[i].class_id;
+    out[i].class_id = cls::isThin(c) ? (pick ? cls::kBuilding : cls::kVegetation)
+                                     : cls::confusionPartner(c, pick);
+  }
   return out;
 }
 
@@ -150,8 +181,13 @@ EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, s
   out = shiftColor(out, uniform(rng, -config.max_hue_shift, config.max_hue_shift),
                    1.0 + uniform(rng, -config.max_sv_scale_shift, config.max_sv_scale_shift),
                    1.0 + uniform(rng, -config.max_sv_scale_shift, config.max_sv_scale_shift));
-  return relabelPoints(out, uniform(rng, 0.0, config.max_wrong_class_fraction), config.num_classes,
-                       rng);
+  out = relabelPoints(out, uniform(rng, 0.0, config.max_wrong_class_fraction), config.num_classes,
+                      rng);
+  // Drawn last and only when enabled, so that the draws above are the same as without it.
+  if (config.confused_section_probability > 0 &&
+      std::bernoulli_distribution(config.confused_section_probability)(rng))
+    out = confuseSection(out, uniform(rng, 0.0, config.max_confused_fraction), rng);
+  return out;
 }
 
 }  // namespace semsegmap

@@ -24,7 +24,13 @@ struct AugmentConfig {
   double max_hue_shift = 0.05;            // hue += [-x, x], cyclic
   double max_sv_scale_shift = 0.2;        // saturation and value *= [1 - x, 1 + x]
   double max_wrong_class_fraction = 0.1;  // share of the points given another class
-  int num_classes = 15;                   // wrong classes are drawn from 1 .. num_classes - 1
+  // A network's errors come in regions, not salt (sim/label_noise.h): with this probability a
+  // planar section of up to max_confused_fraction of the points takes the class a network
+  // confuses its own with (cls::confusionPartner; thin objects the class behind them). 0 keeps
+  // the random draws, and so the models, of the recipe before it.
+  double confused_section_probability = 0.0;
+  double max_confused_fraction = 0.5;
+  int num_classes = 15;  // wrong classes are drawn from 1 .. num_classes - 1
 };
 
 Eigen::Vector3f centroidOf(const EnrichedCloud& cloud);
@@ -50,6 +56,11 @@ EnrichedCloud shiftColor(const EnrichedCloud& cloud, double hue_shift, double sa
 // Each point gets, with probability `fraction`, a class other than its own in 1..num_classes-1.
 EnrichedCloud relabelPoints(const EnrichedCloud& cloud, double fraction, int num_classes,
                             std::mt19937& rng);
+
+// A plane of random direction, placed as in cutSection; the points beyond it take the class a
+// network confuses theirs with (one partner choice for the whole section), thin objects a
+// building or vegetation behind them. Classes without a partner keep theirs.
+EnrichedCloud confuseSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng);
 
 // All of the above with random strengths within `config`.
 EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, std::mt19937& rng);

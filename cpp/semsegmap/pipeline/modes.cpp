@@ -73,10 +73,15 @@ MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSou
 
 namespace {
 std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map,
-                                            const Describer& describer) {
+                                            const Describer& describer,
+                                            const LocalizationConfig& config) {
   if (!map) throw std::invalid_argument("no target map");
   checkMapCompatible("the target map", *map, descriptorName(describer.kind()),
                      describer.fingerprint(), describer.dimension());
+  if (config.refinement.enabled && !hasSegmentPoints(*map))
+    throw std::invalid_argument(
+        "the target map stores no segment points, which localization.refinement needs: build "
+        "it with target_map.max_points_per_segment (map --points N) or turn refinement off");
   return map;
 }
 }  // namespace
@@ -85,7 +90,8 @@ LocalizationSession::LocalizationSession(const PipelineConfig& config, const Dat
                                          std::shared_ptr<const TargetMap> map,
                                          std::shared_ptr<Describer> describer)
     : config_(config),
-      localizer_(checkedMap(std::move(map), *describer), config.localization.localizer),
+      localizer_(checkedMap(std::move(map), *describer, config.localization),
+                 config.localization.localizer),
       pipeline_(config, info, PoseSource::kOdometry, std::move(describer)) {}
 
 void LocalizationSession::process(const Frame& frame) {
@@ -98,11 +104,22 @@ void LocalizationSession::process(const Frame& frame) {
   const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
   if (frames_++ % every == 0) {
     const auto t0 = std::chrono::steady_clock::now();
-    const LocalSegmentQuery q = pipeline_.localSegmentQuery();
-    const auto found = localizer_.localize(q.centroids, q.descriptors);
+    const RefinementConfig& refinement = config_.localization.refinement;
+    const LocalSegmentQuery q =
+        pipeline_.localSegmentQuery(refinement.enabled ? refinement.max_points_per_segment : 0);
+    auto found = localizer_.localize(q.centroids, q.descriptors);
+    std::optional<Refinement> refined;
+    if (found && refinement.enabled) {
+      refined = refinePose(*found, q.points, localizer_.map(), refinement);
+      found->T_map_local = refined->T_map_local;
+    }
     r.times.localize_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (found) record(frame, r, *found, q);
+    if (refined) {
+      run_.localizations.back().refined = refined->applied;
+      run_.localizations.back().refinement_correction_m = refined->correction_m;
+    }
   }
   run_.stats.total += r.times;
   ++run_.stats.frames;

@@ -67,6 +67,9 @@ struct LocalizationRecord {
   double translation_error_m = 0.0, rotation_error_deg = 0.0;  // only with ground truth
   // Matched centroids: the local one carried into the map by the estimate, and the target's.
   std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> matches;
+  // Pose refinement (localization.refinement): whether it moved T_map_base, and by how much.
+  bool refined = false;
+  double refinement_correction_m = 0.0;
 };
 
 struct LocalizationRun {

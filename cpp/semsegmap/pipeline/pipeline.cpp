@@ -71,7 +71,19 @@ void Pipeline::describe(const std::vector<SegmentId>& ids, size_t frame_index) {
   }
 }
 
-LocalSegmentQuery Pipeline::localSegmentQuery() const {
+std::vector<Eigen::Vector3f> Pipeline::observedPoints(const DescribedSegment& e,
+                                                      size_t max_points) const {
+  // The described observation is the segment's last one (a segment is described each time it is
+  // observed); a segment without it (cannot happen) contributes no points rather than others.
+  const Segment* s = segmenter_.segment(e.id);
+  if (!s || s->observations.empty() || s->last().n_points != e.n_points) return {};
+  std::vector<Eigen::Vector3f> all;
+  all.reserve(s->last().points.size());
+  for (const EnrichedPoint& p : s->last().points) all.emplace_back(p.x, p.y, p.z);
+  return subsamplePoints(all, max_points);
+}
+
+LocalSegmentQuery Pipeline::localSegmentQuery(size_t max_points_per_segment) const {
   LocalSegmentQuery q;
   for (const auto& [id, e] : described_) q.ids.push_back(id);
   std::sort(q.ids.begin(), q.ids.end());
@@ -81,6 +93,7 @@ LocalSegmentQuery Pipeline::localSegmentQuery() const {
     const DescribedSegment& e = described_.at(q.ids[i]);
     q.centroids.push_back(e.centroid);
     q.descriptors.row(static_cast<Eigen::Index>(i)) = e.descriptor.transpose();
+    if (max_points_per_segment > 0) q.points.push_back(observedPoints(e, max_points_per_segment));
   }
   return q;
 }

@@ -57,6 +57,9 @@ struct LocalSegmentQuery {
   std::vector<SegmentId> ids;
   std::vector<Eigen::Vector3f> centroids;
   Eigen::MatrixXf descriptors;
+  // Per segment, the points of its described observation (local map frame, at most the number
+  // asked for, evenly spaced): for pose refinement; empty unless asked for.
+  std::vector<std::vector<Eigen::Vector3f>> points;
 };
 
 class Pipeline {
@@ -76,13 +79,15 @@ class Pipeline {
   const std::unordered_map<SegmentId, DescribedSegment>& localSegments() const {
     return described_;
   }
-  LocalSegmentQuery localSegmentQuery() const;
+  // `max_points_per_segment` > 0 also fills the query's points.
+  LocalSegmentQuery localSegmentQuery(size_t max_points_per_segment = 0) const;
   const Describer* describer() const { return describer_.get(); }
 
  private:
   void describe(const std::vector<SegmentId>& ids, size_t frame_index);
   // The descriptor of a finished segment's final observation.
   Eigen::VectorXf finalDescriptor(const Segment& s) const;
+  std::vector<Eigen::Vector3f> observedPoints(const DescribedSegment& e, size_t max_points) const;
 
   PipelineConfig config_;
   DatasetInfo info_;

@@ -8,6 +8,7 @@
 #include "semsegmap/graph/pose_graph.h"
 #include "semsegmap/local_map/local_map.h"
 #include "semsegmap/localize/localizer.h"
+#include "semsegmap/localize/pose_refinement.h"
 #include "semsegmap/localize/target_map.h"
 #include "semsegmap/segment/semantic_distance.h"
 
@@ -22,6 +23,9 @@ struct DescriptorConfig {
 struct LocalizationConfig {
   LocalizerConfig localizer;
   size_t every_n_frames = 1;  // query the target map every n-th frame
+  // Off by default: it needs a target map with segment points (target_map.
+  // max_points_per_segment), which costs 6 bytes a point.
+  RefinementConfig refinement;
 };
 
 struct LoopClosureConfig {

@@ -48,37 +48,12 @@ double thresholdForShare(double share) {
   return q[i] + (q[i + 1] - q[i]) * (pos - i);
 }
 
-// The class a confused pixel takes: walls, fences and hedges, terrain and sidewalks, roofs and
-// walls are what networks mix up; `pick` chooses between two partners per blob.
-ClassId confusionPartner(ClassId c, bool pick) {
-  switch (c) {
-    case cls::kFence:
-      return pick ? cls::kBuilding : cls::kVegetation;
-    case cls::kBuilding:
-      return cls::kFence;
-    case cls::kVegetation:
-      return cls::kFence;
-    case cls::kTerrain:
-      return cls::kSidewalk;
-    case cls::kSidewalk:
-      return cls::kTerrain;
-    case cls::kRoof:
-      return cls::kBuilding;
-    default:
-      return c;
-  }
-}
-
-bool isThin(ClassId c) {
-  return c == cls::kPole || c == cls::kTrafficSign || c == cls::kTrunk;
-}
-
 // The nearest label left or right of (x, y) that is not a thin object: what a network that
 // misses a pole sees through it.
 uint8_t background(const Image& labels, int x, int y) {
   for (int d = 1; d < labels.width; ++d) {
-    if (x - d >= 0 && !isThin(*labels.at(x - d, y))) return *labels.at(x - d, y);
-    if (x + d < labels.width && !isThin(*labels.at(x + d, y))) return *labels.at(x + d, y);
+    if (x - d >= 0 && !cls::isThin(*labels.at(x - d, y))) return *labels.at(x - d, y);
+    if (x + d < labels.width && !cls::isThin(*labels.at(x + d, y))) return *labels.at(x + d, y);
   }
   return cls::kUnknown;
 }
@@ -123,8 +98,8 @@ Image applyLabelNoise(const Image& labels, const LabelNoise& noise, uint64_t see
           y + static_cast<int>(std::lround((2 * shift_y.at(x, y) - 1) * noise.boundary_px)), 0,
           labels.height - 1);
       ClassId c = *labels.at(sx, sy);
-      if (isThin(c) && missed.at(x, y) < missed_below) c = background(labels, sx, sy);
-      if (confused.at(x, y) < confusion_below) c = confusionPartner(c, partner.at(x, y) < 0.5);
+      if (cls::isThin(c) && missed.at(x, y) < missed_below) c = background(labels, sx, sy);
+      if (confused.at(x, y) < confusion_below) c = cls::confusionPartner(c, partner.at(x, y) < 0.5);
       if (region.at(x, y) < region_below && c != cls::kSky && c != cls::kUnknown) c = region_class;
       *out.at(x, y) = static_cast<uint8_t>(c);
     }
