@@ -12,9 +12,7 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,6 +29,7 @@
 #include <open3d/pipelines/registration/Registration.h>
 #endif
 
+#include "semsegmap/io/kitti_calib.h"
 #include "semsegmap/odometry/lidar_odometry.h"
 
 using namespace semsegmap;
@@ -45,30 +44,14 @@ struct KittiScans {
   std::vector<Pose> gt;  // LiDAR poses: Tr^-1 * P_i * Tr
 };
 
-Pose poseFromRow(std::istream& in) {
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) in >> m(r, c);
-  Pose T;
-  T.matrix() = m;
-  return T;
-}
-
 // The scans once; empty when ../shared/data is not beside the checkout.
 const KittiScans& kitti() {
   static const KittiScans scans = [] {
     KittiScans s;
     if (!std::filesystem::exists(kKitti / "poses.txt")) return s;
-    std::ifstream calib(kKitti / "calib.txt"), poses(kKitti / "poses.txt");
-    std::string line;
-    Pose Tr = Pose::Identity();
-    while (std::getline(calib, line))
-      if (line.rfind("Tr:", 0) == 0) {
-        std::istringstream row(line.substr(3));
-        Tr = poseFromRow(row);
-      }
+    const Pose Tr = KittiCalibFile(kKitti / "calib.txt").transform3x4("Tr");
+    s.gt = kittiLidarPoses(readKittiPoses(kKitti / "poses.txt"), Tr);
     for (int i = 0; i < 10; ++i) {
-      s.gt.push_back(Tr.inverse() * poseFromRow(poses) * Tr);
       char name[16];
       std::snprintf(name, sizeof(name), "%06d.pcd", i);
       s.clouds.emplace_back(new pcl::PointCloud<pcl::PointXYZ>);

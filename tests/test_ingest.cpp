@@ -11,6 +11,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
+#include "error_text.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/sensor_rig.h"
 #include "semsegmap/datasets/open_dataset.h"
@@ -34,20 +35,12 @@
 
 namespace fs = std::filesystem;
 using namespace semsegmap;
+using semsegmap::test_support::errorOf;
 using semsegmap::test_support::TempDir;
 
 namespace {
 
 const fs::path kShared = SEMSEGMAP_SHARED_DATA;
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 void writeText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());

@@ -5,9 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 
 #include "semsegmap/core/binary_io.h"
 #include "semsegmap/datasets/lidar_odometry_source.h"
@@ -511,28 +509,6 @@ TEST(OdometryOnRealScans, Kitti00ConsecutivePairsMeetTheTarget) {
 const std::filesystem::path kKitti =
     std::filesystem::path(SEMSEGMAP_SHARED_DATA) / "kitti00_first10_pcd";
 
-// The 12 numbers of a KITTI 3x4 pose line as a pose.
-Pose poseFromRow(std::istream& in) {
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) in >> m(r, c);
-  Pose T;
-  T.matrix() = m;
-  return T;
-}
-
-// Tr (velodyne -> camera 0) of calib.txt.
-Pose velodyneToCamera() {
-  std::ifstream in(kKitti / "calib.txt");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("Tr:", 0) != 0) continue;
-    std::istringstream row(line.substr(3));
-    return poseFromRow(row);
-  }
-  throw std::runtime_error((kKitti / "calib.txt").string() + ": no Tr line");
-}
-
 std::vector<LidarPoint> loadKittiScan(int index) {
   char name[16];
   std::snprintf(name, sizeof(name), "%06d.pcd", index);
@@ -553,10 +529,9 @@ TEST(OdometryOnRealScans, Kitti00FrameToFrameError) {
   if (!std::filesystem::exists(kKitti / "poses.txt"))
     GTEST_SKIP() << "no real KITTI sample (" << kKitti.string()
                  << "): ../shared/data is not beside this checkout";
-  const Pose Tr = velodyneToCamera();
-  std::ifstream poses(kKitti / "poses.txt");
-  std::vector<Pose> gt;  // LiDAR poses: Tr^-1 * P_i * Tr
-  for (int i = 0; i < 10; ++i) gt.push_back(Tr.inverse() * poseFromRow(poses) * Tr);
+  const Pose Tr = KittiCalibFile(kKitti / "calib.txt").transform3x4("Tr");
+  const std::vector<Pose> gt = kittiLidarPoses(readKittiPoses(kKitti / "poses.txt"), Tr);
+  ASSERT_EQ(gt.size(), 10u);
   LidarOdometry odom;
   std::vector<Pose> est;
   for (int i = 0; i < 10; ++i) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "error_text.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/kitti_calib.h"
 #include "semsegmap/io/kitti_raw_reader.h"
@@ -32,6 +33,7 @@ const fs::path kDay =
     fs::path(SEMSEGMAP_SHARED_DATA) / "kitti_raw_2011_09_26_sample" / "2011_09_26";
 const fs::path kDrive = kDay / "sample_sync";
 
+using semsegmap::test_support::errorOf;
 using semsegmap::test_support::TempDir;
 
 // Every KittiRaw test reads the real sample, or copies parts of it to break them.
@@ -43,18 +45,6 @@ class KittiRaw : public ::testing::Test {
                    << "): ../shared/data is not beside this checkout";
   }
 };
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no exception)";
-}
-
-#define EXPECT_MENTIONS(message, text) \
-  EXPECT_NE((message).find(text), std::string::npos) << "message: " << (message)
 
 void writeText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());

@@ -26,6 +26,7 @@
 #include <tf2_msgs/TFMessage.h>
 #endif
 
+#include "error_text.h"
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/kitti_raw_reader.h"
@@ -48,24 +49,11 @@ using semsegmap::LidarPoint;
 using semsegmap::Pose;
 using semsegmap::RosbagOptions;
 using semsegmap::RosbagReader;
+using semsegmap::test_support::errorOf;
 using semsegmap::test_support::TempDir;
 
 // Bag times of the fixtures: ROS 1 refuses a time of 0, so the synthetic clock starts here.
 constexpr double kEpoch = 1317000000.0;
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no exception)";
-}
-
-#define EXPECT_MENTIONS(message, text) \
-  EXPECT_NE((message).find(text), std::string::npos) << "message: " << (message)
-#define EXPECT_ONE_LINE(message) \
-  EXPECT_EQ((message).find('\n'), std::string::npos) << "message: " << (message)
 
 // ---- Building messages --------------------------------------------------------------------
 

@@ -7,11 +7,13 @@
 #include <sstream>
 
 #include "cli_args.h"
+#include "dataset_args.h"
 #include "progress.h"
 #include "resources.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/eval/report.h"
+#include "semsegmap/eval/revisit_experiment.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
 
@@ -177,6 +179,29 @@ int runEvalPaper(const CliArgs& a) {
   return 0;
 }
 
+int runEvalRevisits(const CliArgs& a) {
+  RevisitExperimentConfig c;
+  try {
+    c.map_frames = parseFrameRanges(a.get("map-frames"), "option --map-frames");
+    c.query_frames = parseFrameRanges(a.get("query-frames"), "option --query-frames");
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  c.place_radius_m = a.getNumber("place-radius");
+  c.configs = comparedConfigs(a);
+  for (const NamedConfig& config : c.configs)
+    requireDescriberBuilt(config.config.descriptor, config.path.string());
+  // LiDAR odometry and a segmentation network come from the first configuration's sections.
+  const std::unique_ptr<FrameSource> source = openDatasetArg(a, c.configs.front().path);
+  StageProgress progress;
+  const std::filesystem::path out = a.get("out");
+  const RevisitExperiment e = evaluateRevisits(*source, c, out, std::ref(progress));
+  writeRevisitFiles(e, out);
+  std::cout << revisitTable(e) << "wrote " << (out / "revisits.json").string()
+            << ", revisits.png and one folder per configuration\n";
+  return 0;
+}
+
 // The options of the experiments, each declared once.
 const OptionSpec kWorldSeed{"world-seed", Value::kCount, "N", "1", "seed of the procedural world"};
 const OptionSpec kOut{"out", Value::kText, "DIR", "", "output folder", kRequired};
@@ -232,6 +257,22 @@ const std::vector<const CommandSpec*>& evalCommands() {
        kQueryOdometry},
       "",
       runEvalLocalization};
+  static const CommandSpec revisits{
+      "eval revisits",
+      "maps some frames of a recording, localizes others against them -> revisits.json",
+      datasetOptions(
+          "a recording with ground-truth poses",
+          {{"map-frames", Value::kText, "A:B[,C:D]", "",
+            "frames the target map is built from (as the dataset lists them, from 0)", kRequired},
+           {"query-frames", Value::kText, "E:F[,G:H]", "",
+            "frames localized against it, on the dataset's odometry", kRequired},
+           {"configs", Value::kText, "A.yaml,B.yaml",
+            "config/semsegmap-kitti.yaml,config/segmap-kitti.yaml",
+            "the configurations compared (default: the shipped real-data ones)"},
+           {"place-radius", Value::kNumber, "M", "10",
+            "a query frame this close to a mapped frame is at a revisit"},
+           kOut}),
+      "", runEvalRevisits};
   static const CommandSpec paper{
       "eval paper",
       "the segmentation, descriptor and localization experiments, and report.md",
@@ -240,7 +281,7 @@ const std::vector<const CommandSpec*>& evalCommands() {
       "",
       runEvalPaper};
   static const std::vector<const CommandSpec*> all = {&segmentation, &descriptors, &localization,
-                                                      &paper};
+                                                      &revisits, &paper};
   return all;
 }
 

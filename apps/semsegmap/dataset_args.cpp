@@ -34,7 +34,7 @@ std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<Opti
   return options;
 }
 
-std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a) {
+std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesystem::path& config) {
   DatasetOptions options;
   if (a.has("rig")) options.rig = a.get("rig");
   const auto& declared = a.command().options;
@@ -43,12 +43,13 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a) {
                        [&](const OptionSpec& o) { return o.name == name; });
   };
   if (declares("odometry") && a.has("odometry")) options.odometry = a.get("odometry");
+  std::filesystem::path sections = config;
+  if (sections.empty() && declares("config") && a.has("config")) sections = a.get("config");
   // LiDAR odometry takes its settings from the odometry section of the command's config.
-  if (options.odometry == "lidar" && declares("config") && a.has("config"))
-    options.lidar_odometry = loadOdometryConfig(a.get("config"));
+  if (options.odometry == "lidar" && !sections.empty())
+    options.lidar_odometry = loadOdometryConfig(sections);
   // The segmentation network of the config's semantics: section labels pictures without labels.
-  if (declares("labels") && declares("config") && a.has("config"))
-    options.semantics = loadSemanticsConfig(a.get("config"));
+  if (declares("labels") && !sections.empty()) options.semantics = loadSemanticsConfig(sections);
   if (declares("labels") && a.has("labels")) options.labels = a.get("labels");
   if (!options.semantics.model.empty() || !options.labels.empty())
     options.class_maps_dir = shippedFile("config/class_maps");

@@ -2,6 +2,7 @@
 // own recording: its rig file and the poses it lacks.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,9 @@ std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<Opti
 
 // openDataset() with those options. A command that takes --labels also gets the segmentation
 // network of its --config's semantics: section, when it names one.
-std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a);
+// `config` names the configuration whose odometry: and semantics: sections apply, for commands
+// that take several (eval revisits); by default the command's --config.
+std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a,
+                                            const std::filesystem::path& config = {});
 
 }  // namespace semsegmap::app

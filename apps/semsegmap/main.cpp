@@ -108,7 +108,7 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
   if (args[0] != "eval") throw UsageError("unknown command '" + args[0] + "'");
 #if SEMSEGMAP_WITH_SIM
   *name = "eval";
-  const std::string expected = "segmentation, descriptors, localization or paper";
+  const std::string expected = "segmentation, descriptors, localization, revisits or paper";
   if (args.size() < 2 || args[1].rfind("-", 0) == 0)
     throw UsageError("eval needs an experiment: " + expected);
   for (const CommandSpec* c : evalCommands()) {

@@ -1,5 +1,6 @@
 #include "semsegmap/eval/localization_experiment.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -7,9 +8,8 @@
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/open_dataset.h"
+#include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/localization_metrics.h"
-#include "semsegmap/eval/localization_picture.h"
-#include "semsegmap/io/map_file.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/io/run_output.h"
 #include "semsegmap/viz/plot.h"
@@ -18,16 +18,6 @@ namespace semsegmap {
 
 namespace {
 
-// A configuration's target map as built (with the picture points) and the size of its file.
-struct BuiltMap {
-  std::shared_ptr<const TargetMap> map;
-  uint64_t bytes = 0;
-};
-
-std::filesystem::path mapPath(const std::filesystem::path& out, const NamedConfig& config) {
-  return out / "maps" / (config.name + ".map");
-}
-
 // The map run, rendered once for every configuration; each map is saved into out/maps/.
 std::vector<BuiltMap> buildMaps(const LocalizationExperimentConfig& cfg,
                                 const std::vector<std::shared_ptr<Describer>>& describers,
@@ -35,27 +25,12 @@ std::vector<BuiltMap> buildMaps(const LocalizationExperimentConfig& cfg,
                                 const ExperimentProgress& progress) {
   auto source = openDataset(
       simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset, cfg.max_frames, cfg.label_noise));
-  std::vector<std::unique_ptr<MappingSession>> sessions;
-  for (size_t c = 0; c < cfg.configs.size(); ++c) {
-    PipelineConfig pc = cfg.configs[c].config;
-    pc.target_map.max_points_per_segment = cfg.picture_points_per_segment;
-    sessions.push_back(std::make_unique<MappingSession>(pc, source->info(),
-                                                        PoseSource::kGroundTruth, describers[c]));
-  }
+  auto sessions =
+      mappingSessions(cfg.configs, source->info(), describers, cfg.picture_points_per_segment);
   forEachFrame(*source, "map " + cfg.map_run, progress, [&](const Frame& frame) {
     for (auto& s : sessions) s->process(frame);
   });
-  std::vector<BuiltMap> maps;
-  for (size_t c = 0; c < cfg.configs.size(); ++c) {
-    BuiltMap m;
-    m.map = std::make_shared<const TargetMap>(sessions[c]->finish().map);
-    // The saved map is what a robot carries: without the picture points.
-    TargetMap saved = *m.map;
-    for (MapSegment& s : saved.segments) s.points.clear();
-    m.bytes = saveTargetMap(mapPath(out, cfg.configs[c]), saved);
-    maps.push_back(std::move(m));
-  }
-  return maps;
+  return finishMaps(sessions, cfg.configs, out);
 }
 
 LocalizationResult resultOf(const LocalizationExperiment& e, const NamedConfig& config,
@@ -96,19 +71,12 @@ LocalizationResult resultOf(const LocalizationExperiment& e, const NamedConfig& 
 void writeRunFiles(const LocalizationExperimentConfig& cfg, const NamedConfig& config,
                    const LocalizationRun& run, const BuiltMap& map, const LocalizationResult& r,
                    const std::filesystem::path& out) {
-  const std::filesystem::path dir = out / r.dir;
-  std::filesystem::create_directories(dir);
-  writeLocalizationsCsv(dir / "localizations.csv", run);
   SummaryContext context;
   context.dataset = r.dataset;
-  context.map = mapPath(out, config).string();
+  context.map = builtMapPath(out, config).string();
   context.config = config.path.string();
-  context.descriptor = map.map->descriptor;
-  context.map_segments = map.map->size();
-  context.map_bytes = map.bytes;
-  writeBytesAtomically(dir / "summary.json", localizationSummaryJson(run, context));
-  writeLocalizationPicture(
-      dir / "localization.png", run, *map.map,
+  writeLocalizationRunFiles(
+      out / r.dir, run, map, context,
       r.run + " (" + r.dataset + ") against the " + cfg.map_run + " map, " + config.name);
 }
 

@@ -143,7 +143,8 @@ void plotPanels(const std::filesystem::path& png, const std::string& title,
   std::filesystem::create_directories(dir);
   std::ostringstream gp;
   const int width = 520 * static_cast<int>(panels.size());
-  gp << "set terminal pngcairo size " << width << ",520 font 'sans,10'\n"
+  // noenhanced: names such as kitti_odometry_00 are printed as they are, not as subscripts.
+  gp << "set terminal pngcairo noenhanced size " << width << ",520 font 'sans,10'\n"
      << "set output " << quoted(png.string() + ".tmp") << "\n"
      << "set multiplot layout 1," << panels.size() << " title " << quoted(title) << "\n"
      << "set grid\nset key bottom right\n";
