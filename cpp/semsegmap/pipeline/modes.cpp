@@ -104,29 +104,33 @@ void LocalizationSession::process(const Frame& frame) {
   const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
   if (frames_++ % every == 0) {
     const auto t0 = std::chrono::steady_clock::now();
-    const RefinementConfig& refinement = config_.localization.refinement;
-    const LocalSegmentQuery q =
-        pipeline_.localSegmentQuery(refinement.enabled ? refinement.max_points_per_segment : 0);
+    const LocalSegmentQuery q = pipeline_.localSegmentQuery();
     auto found = localizer_.localize(q.centroids, q.descriptors);
     std::optional<Refinement> refined;
-    if (found && refinement.enabled) {
-      refined = refinePose(*found, q.points, localizer_.map(), refinement);
+    if (found && config_.localization.refinement.enabled) {
+      refined = refine(*found, q);
       found->T_map_local = refined->T_map_local;
     }
     r.times.localize_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (found) record(frame, r, *found, q);
-    if (refined) {
-      run_.localizations.back().refined = refined->applied;
-      run_.localizations.back().refinement_correction_m = refined->correction_m;
-    }
+    if (found) record(frame, r, *found, q, refined ? &*refined : nullptr);
   }
   run_.stats.total += r.times;
   ++run_.stats.frames;
 }
 
+Refinement LocalizationSession::refine(const Localization& l, const LocalSegmentQuery& q) const {
+  // Only the matched segments' points, and only once a match is found: copying every local
+  // segment's points on every frame would be most of the work for nothing.
+  std::vector<std::vector<Eigen::Vector3f>> local_points(q.ids.size());
+  for (const auto& [query, target] : l.matches)
+    if (local_points.at(query).empty())
+      local_points[query] = pipeline_.observedPoints(q.ids[query]);
+  return refinePose(l, local_points, localizer_.map(), config_.localization.refinement);
+}
+
 void LocalizationSession::record(const Frame& frame, const FrameResult& r, const Localization& l,
-                                 const LocalSegmentQuery& q) {
+                                 const LocalSegmentQuery& q, const Refinement* refined) {
   LocalizationRecord rec;
   rec.frame_index = frame.index;
   rec.timestamp_s = frame.timestamp_s;
@@ -137,6 +141,10 @@ void LocalizationSession::record(const Frame& frame, const FrameResult& r, const
     rec.T_world_base = *frame.T_world_base;
     rec.translation_error_m = translationError(rec.T_map_base, *frame.T_world_base);
     rec.rotation_error_deg = rotationErrorDeg(rec.T_map_base, *frame.T_world_base);
+  }
+  if (refined) {
+    rec.refined = refined->applied;
+    rec.refinement_correction_m = refined->correction_m;
   }
   for (const auto& [query, target] : l.matches)
     rec.matches.emplace_back((l.T_map_local * q.centroids.at(query).cast<double>()).cast<float>(),

@@ -92,8 +92,10 @@ class LocalizationSession {
   LocalizationRun take() { return std::move(run_); }
 
  private:
+  Refinement refine(const Localization& l, const LocalSegmentQuery& q) const;
+  // `refined`: the refinement of `l`, when it was refined.
   void record(const Frame& frame, const FrameResult& r, const Localization& l,
-              const LocalSegmentQuery& q);
+              const LocalSegmentQuery& q, const Refinement* refined);
   PipelineConfig config_;
   Localizer localizer_;
   Pipeline pipeline_;

@@ -71,19 +71,19 @@ void Pipeline::describe(const std::vector<SegmentId>& ids, size_t frame_index) {
   }
 }
 
-std::vector<Eigen::Vector3f> Pipeline::observedPoints(const DescribedSegment& e,
-                                                      size_t max_points) const {
+std::vector<Eigen::Vector3f> Pipeline::observedPoints(SegmentId id) const {
   // The described observation is the segment's last one (a segment is described each time it is
   // observed); a segment without it (cannot happen) contributes no points rather than others.
-  const Segment* s = segmenter_.segment(e.id);
+  const DescribedSegment& e = described_.at(id);
+  const Segment* s = segmenter_.segment(id);
   if (!s || s->observations.empty() || s->last().n_points != e.n_points) return {};
-  std::vector<Eigen::Vector3f> all;
-  all.reserve(s->last().points.size());
-  for (const EnrichedPoint& p : s->last().points) all.emplace_back(p.x, p.y, p.z);
-  return subsamplePoints(all, max_points);
+  std::vector<Eigen::Vector3f> points;
+  points.reserve(s->last().points.size());
+  for (const EnrichedPoint& p : s->last().points) points.emplace_back(p.x, p.y, p.z);
+  return points;
 }
 
-LocalSegmentQuery Pipeline::localSegmentQuery(size_t max_points_per_segment) const {
+LocalSegmentQuery Pipeline::localSegmentQuery() const {
   LocalSegmentQuery q;
   for (const auto& [id, e] : described_) q.ids.push_back(id);
   std::sort(q.ids.begin(), q.ids.end());
@@ -93,7 +93,6 @@ LocalSegmentQuery Pipeline::localSegmentQuery(size_t max_points_per_segment) con
     const DescribedSegment& e = described_.at(q.ids[i]);
     q.centroids.push_back(e.centroid);
     q.descriptors.row(static_cast<Eigen::Index>(i)) = e.descriptor.transpose();
-    if (max_points_per_segment > 0) q.points.push_back(observedPoints(e, max_points_per_segment));
   }
   return q;
 }

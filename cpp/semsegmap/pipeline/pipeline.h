@@ -57,9 +57,6 @@ struct LocalSegmentQuery {
   std::vector<SegmentId> ids;
   std::vector<Eigen::Vector3f> centroids;
   Eigen::MatrixXf descriptors;
-  // Per segment, the points of its described observation (local map frame, at most the number
-  // asked for, evenly spaced): for pose refinement; empty unless asked for.
-  std::vector<std::vector<Eigen::Vector3f>> points;
 };
 
 class Pipeline {
@@ -79,15 +76,16 @@ class Pipeline {
   const std::unordered_map<SegmentId, DescribedSegment>& localSegments() const {
     return described_;
   }
-  // `max_points_per_segment` > 0 also fills the query's points.
-  LocalSegmentQuery localSegmentQuery(size_t max_points_per_segment = 0) const;
+  LocalSegmentQuery localSegmentQuery() const;
+  // The points of a local segment's described observation (local map frame), for pose
+  // refinement: asked for the matched segments only, after a localization.
+  std::vector<Eigen::Vector3f> observedPoints(SegmentId id) const;
   const Describer* describer() const { return describer_.get(); }
 
  private:
   void describe(const std::vector<SegmentId>& ids, size_t frame_index);
   // The descriptor of a finished segment's final observation.
   Eigen::VectorXf finalDescriptor(const Segment& s) const;
-  std::vector<Eigen::Vector3f> observedPoints(const DescribedSegment& e, size_t max_points) const;
 
   PipelineConfig config_;
   DatasetInfo info_;
