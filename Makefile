@@ -29,7 +29,7 @@ bench: build
 	./$(BUILD)/bench/semsegmap_bench
 
 format:
-	find cpp apps tests bench -name '*.cpp' -o -name '*.h' | xargs clang-format -i
+	find cpp apps tests bench python/src -name '*.cpp' -o -name '*.h' | xargs clang-format -i
 
 clean:
 	rm -rf build build-asan build-min

@@ -16,14 +16,21 @@ packages=(
   gnuplot-nox
   # the tests and the benchmark generate their small ONNX segmentation networks with it
   python3-onnx python3-numpy
+  # the Python module (python/, SEMSEGMAP_WITH_PYTHON) and its pytest suite, for Debian's python3
+  pybind11-dev python3-dev python3-pytest
   # make bench only: the odometry benchmark compares Open3D's registration (optional in CMake)
   libopen3d-dev
+  # semsegmap view: its page is bundled with Node.js at build time (viewer/, npm ci), and its
+  # test opens the page in headless Chromium
+  nodejs chromium
 )
 
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Debian's nodejs comes without npm; a Node.js that brings its own (NodeSource's) conflicts with it.
+command -v npm > /dev/null || missing+=(npm)
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0
 fi

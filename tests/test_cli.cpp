@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "command_result.h"
 #include "temp_dir.h"
 
 namespace semsegmap {
@@ -24,17 +25,8 @@ using test_support::TempDir;
 
 std::string g_binary;  // set by main
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string readFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test_support::readFile;
+using test_support::Result;
 
 // Runs `semsegmap ARGS` with stdout and stderr into files (so neither is a terminal).
 Result run(const std::string& args) {
@@ -100,7 +92,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"map", "poses", "odometry"}},
     {"train",
      {"descriptor", "dataset", "out", "epochs", "batch", "threads", "config", "max-frames", "cache",
-      "anchors-per-epoch", "lr", "seed", "confused-sections", "points", "history"},
+      "anchors-per-epoch", "lr", "seed", "confused-sections", "lidar-only", "points", "history"},
      {"world-seed", "map"}},
     {"demo", {"out", "world-seed", "preset", "max-frames"}, {"configs", "dataset"}},
     {"eval segmentation",
@@ -116,7 +108,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"descriptors", "segmentation-run"}},
     {"eval revisits",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "map-frames",
-      "query-frames", "configs", "place-radius", "out"},
+      "query-frames", "configs", "place-radius", "check-ground-truth", "wake-up", "out"},
      {"world-seed", "preset", "map-run"}},
     {"eval paper",
      {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run", "config",

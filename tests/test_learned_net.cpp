@@ -366,10 +366,10 @@ TEST(ModelFile, RoundTripAndErrors) {
     expectFileError([&] { loadNet(truncated); }, truncated, "truncated");
 
     std::string other_version = bytes;
-    other_version[6] = 3;  // the format version follows the 6-byte magic
+    other_version[6] = 4;  // the format version follows the 6-byte magic
     const auto future = dir / "future.ssmnet";
     writeBytes(future, other_version);
-    expectFileError([&] { loadNet(future); }, future, "version 3");
+    expectFileError([&] { loadNet(future); }, future, "version 4");
 
     const auto bad_magic = dir / "bad_magic.ssmnet";
     writeBytes(bad_magic, "X" + bytes.substr(1));
@@ -423,6 +423,38 @@ TEST(ModelFile, SetAbstractionIsRecordedAndFingerprinted) {
   NetConfig bad = config;
   bad.sa2_divisor = 3;  // num_points is no multiple of it
   EXPECT_THROW(validateNetConfig(bad), std::invalid_argument);
+  std::filesystem::remove_all(dir);
+}
+
+// A LiDAR-only model sees every point without colour and as of class unknown, whatever the data
+// carries; the file records it, and the fingerprint tells it from the same weights with both.
+TEST(ModelFile, ModalitiesAreRecordedFingerprintedAndApplied) {
+  const auto dir = tempDir();
+  NetConfig config = tinyConfig(DescriptorKind::kSemSegMapNet);
+  torch::manual_seed(5);
+  const auto net = makeNet(config);
+  config.use_color = config.use_classes = false;
+  torch::manual_seed(5);
+  const auto lidar = makeNet(config);
+  EXPECT_NE(netFingerprint(*lidar), netFingerprint(*net));
+  const auto path = dir / "lidar.ssmnet";
+  saveNet(path, *lidar);
+  EXPECT_EQ(readBytes(path)[6], 3) << "format version 3 records the modalities";
+  const Model model = readModelFile(path);
+  EXPECT_FALSE(model.config.use_color);
+  EXPECT_FALSE(model.config.use_classes);
+  EXPECT_EQ(netFingerprint(*netFromModel(model)), netFingerprint(*lidar));
+
+  const EnrichedCloud car = makeShape(0, 300, 1);  // coloured points of class car
+  const NetInput with = makeNetInput(net->config(), {&car}, {7});
+  const NetInput without = makeNetInput(config, {&car}, {7});
+  EXPECT_GT(with.points.narrow(2, 3, 3).abs().sum().item<float>(), 1.0f);
+  EXPECT_EQ(without.points.narrow(2, 3, 3).abs().sum().item<float>(), 0.0f);
+  EXPECT_GT(with.class_grid[0][cls::kCar].sum().item<float>(), 0.0f);
+  EXPECT_EQ(without.class_grid[0][cls::kCar].sum().item<float>(), 0.0f);
+  EXPECT_NEAR(without.class_grid[0][cls::kUnknown].sum().item<float>(),
+              with.class_grid[0][cls::kCar].sum().item<float>(), 1e-4);
+  EXPECT_TRUE(torch::equal(with.points.narrow(2, 0, 3), without.points.narrow(2, 0, 3)));
   std::filesystem::remove_all(dir);
 }
 

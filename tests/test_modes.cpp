@@ -18,6 +18,7 @@
 #include "semsegmap/io/map_file.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/io/run_output.h"
+#include "semsegmap/pipeline/input_modalities.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/slam.h"
 
@@ -157,7 +158,7 @@ TEST(Modes, RefinementRefusesAMapWithoutPoints) {
 TEST(Modes, RealDataConfigMapsAndLocalizesTheKittiSample) {
   PipelineConfig config =
       loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap-kitti.yaml");
-  if (!SEMSEGMAP_WITH_TORCH) config.descriptor = DescriptorConfig{"eigen", "", 64};
+  if (!SEMSEGMAP_WITH_TORCH) config.descriptor = DescriptorConfig{"eigen", "", 64, ""};
   EXPECT_EQ(config.localization.localizer.verification.min_inliers, 7);
   const std::string spec = std::string("kitti-raw:") + SEMSEGMAP_SHARED_DATA +
                            "/kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
@@ -236,6 +237,60 @@ TEST(Modes, SummariesKeepNamesWithQuotesAndBackslashes) {
       nlohmann::json::parse(localizationSummaryJson(LocalizationRun{}, context));
   for (const char* key : {"dataset", "map", "config"}) EXPECT_EQ(loc[key], name) << key;
   EXPECT_FALSE(loc["has_ground_truth"].get<bool>());
+}
+
+}  // namespace
+}  // namespace semsegmap
+
+namespace semsegmap {
+namespace {
+
+// What a recording gives decides the descriptor model: a LiDAR without a camera gets the
+// configuration's LiDAR-only model, anything with colour or classes the main one.
+TEST(Modes, ModelChoiceFollowsTheInputsModalities) {
+  DatasetInfo kitti_odometry;  // scans only: no cameras, no point labels
+  EXPECT_FALSE(inputModalitiesOf(kitti_odometry).color);
+  EXPECT_FALSE(inputModalitiesOf(kitti_odometry).classes);
+  EXPECT_EQ(modalitiesText(inputModalitiesOf(kitti_odometry)), "geometry only");
+  DatasetInfo labelled = kitti_odometry;  // SemanticKITTI: point classes, no camera
+  labelled.has_point_labels = true;
+  EXPECT_TRUE(inputModalitiesOf(labelled).classes);
+  DatasetInfo instances_only = labelled;
+  instances_only.point_labels_have_classes = false;
+  EXPECT_FALSE(inputModalitiesOf(instances_only).classes);
+  DatasetInfo camera = kitti_odometry;
+  camera.rig.cameras.emplace_back();
+  EXPECT_EQ(modalitiesText(inputModalitiesOf(camera)), "colour and classes");
+
+  DescriptorConfig d{"semsegmap-net", "main.model", 64, "lidar.model"};
+  DescriptorChoice c = chooseDescriptor(d, inputModalitiesOf(kitti_odometry));
+  EXPECT_EQ(c.descriptor.model, "lidar.model");
+  EXPECT_NE(c.note.find("model_lidar_only"), std::string::npos) << c.note;
+  for (const DatasetInfo* info : {&labelled, &camera}) {
+    c = chooseDescriptor(d, inputModalitiesOf(*info));
+    EXPECT_EQ(c.descriptor.model, "main.model");
+    EXPECT_TRUE(c.note.empty()) << c.note;
+  }
+  // No LiDAR-only model configured: the main one, said loudly.
+  d.model_lidar_only.clear();
+  c = chooseDescriptor(d, inputModalitiesOf(kitti_odometry));
+  EXPECT_EQ(c.descriptor.model, "main.model");
+  EXPECT_NE(c.note.find("no colour and no classes"), std::string::npos) << c.note;
+  // Descriptors that see geometry only have nothing to choose.
+  c = chooseDescriptor(DescriptorConfig{"eigen", "", 64, ""}, inputModalitiesOf(kitti_odometry));
+  EXPECT_TRUE(c.note.empty());
+  c = chooseDescriptor(DescriptorConfig{"segmap-cnn", "cnn.model", 64, ""},
+                       inputModalitiesOf(kitti_odometry));
+  EXPECT_EQ(c.descriptor.model, "cnn.model");
+  EXPECT_TRUE(c.note.empty()) << c.note;
+}
+
+TEST(Modes, SimulatedLidarWithoutCameraIsGeometryOnly) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  auto source = openDataset("sim:world=1,run=S2,preset=tiny,lidar=vlp32,cameras=0,classes=0");
+  EXPECT_EQ(modalitiesText(inputModalitiesOf(source->info())), "geometry only");
+  EXPECT_EQ(source->info().rig.lidar.rows, 32);
+  EXPECT_THROW(openDataset("sim:world=1,preset=tiny,lidar=hdl65"), std::invalid_argument);
 }
 
 }  // namespace

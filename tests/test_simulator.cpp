@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -70,6 +71,40 @@ TEST(Simulator, IsAStreamingFrameSourceWithGroundTruth) {
   }
   EXPECT_TRUE(source.info().has_point_labels);
   EXPECT_THROW(source.frame(source.size()), std::out_of_range);
+}
+
+// The presets render what their sensors see: a 360-degree HDL-64E sees behind the vehicle, a
+// 70-degree solid-state LiDAR only ahead; without cameras and point classes a frame is what a
+// LiDAR without a camera gives, with the instance ground truth kept for training.
+TEST(Simulator, LidarPresetsAndALidarWithoutCamera) {
+  SimConfig c = tinyConfig();
+  c.render_cameras = false;
+  c.point_classes = false;
+  auto widest_azimuth = [&](const char* preset, size_t* points) {
+    c.rig.lidar = lidarPreset(preset);
+    Simulator sim(c);
+    const Frame f = sim.frame(5);
+    EXPECT_TRUE(f.cameras.empty());
+    EXPECT_FALSE(sim.info().point_labels_have_classes);
+    size_t instances = 0;
+    for (const PointLabel& l : f.point_labels) {
+      EXPECT_EQ(l.class_id, cls::kUnknown);
+      instances += l.instance_id != 0;
+    }
+    EXPECT_GT(instances, f.points.size() / 2) << preset;
+    double widest = 0;
+    for (const LidarPoint& p : f.points)
+      widest = std::max(widest, std::abs(std::atan2(p.y, p.x)) * 180.0 / M_PI);
+    *points = f.points.size();
+    return widest;
+  };
+  size_t hdl64 = 0, vlp32 = 0, solid = 0;
+  EXPECT_GT(widest_azimuth("hdl64", &hdl64), 175.0);
+  EXPECT_GT(widest_azimuth("vlp32", &vlp32), 175.0);
+  EXPECT_LT(widest_azimuth("solid", &solid), 35.1);
+  EXPECT_LT(vlp32, hdl64);  // half the beams
+  EXPECT_GT(solid, 1000u);
+  EXPECT_THROW(lidarPreset("hdl65"), std::invalid_argument);
 }
 
 TEST(Simulator, LidarAndCameraAgreeOnClasses) {

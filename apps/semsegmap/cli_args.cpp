@@ -138,7 +138,8 @@ const char* const kDatasetNotes =
     "    [,base_frame=F][,odom_frame=F][,tolerance=S] (ROS 1 and ROS 2 bags),\n"
     "  "
     "sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small][,sweep=1]\n"
-    "    [,label_noise=0..3] (the built-in simulator)\n";
+    "    [,label_noise=0..3][,lidar=paper|hdl64|vlp32|os128|solid][,cameras=0][,classes=0]\n"
+    "    (the built-in simulator; cameras=0,classes=0: a LiDAR without a camera)\n";
 #else
     "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,\n"
     "  folder:DIR[,rig=FILE][,times=FILE][,tolerance=S] (scans and pictures, docs/rig-format.md),\n"

@@ -1,7 +1,8 @@
 // semsegmap demo: the main job on simulated data. On the small world: an overview picture, a
 // target map from S0, and S2 (same light) and S3 (sunrise) localized against it with SemSegMap
 // and the SegMap baseline on the same frames; the table on stdout, report.md and pictures in
-// the output folder. Uses only files in the repository (configs and shipped models).
+// the output folder, with view.html, the S3 localization in 3D (semsegmap view). Uses only files
+// in the repository (configs and shipped models).
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -10,14 +11,38 @@
 #include "progress.h"
 #include "resources.h"
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/report.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/sim/simulator.h"
 #include "semsegmap/viz/sim_overview.h"
+#if SEMSEGMAP_WITH_VIEWER
+#include "viewer_asset.h"
+#endif
 
 namespace semsegmap::app {
 
 namespace {
+
+// view.html: the 3D view of the first configuration's (SemSegMap's) S3 localization, the
+// reversed run at sunrise; its file name, or nothing in a build without the viewer.
+std::string writeDemoView(const LocalizationExperiment& e, const std::filesystem::path& out) {
+#if SEMSEGMAP_WITH_VIEWER
+  for (const LocalizationResult& r : e.results) {
+    if (r.run != "S3" || r.config != e.config.configs.front().name) continue;
+    ViewSources s;
+    s.map = builtMapPath(out, e.config.configs.front());
+    s.localization = out / r.dir;
+    s.title = "demo: " + r.run + " against the " + e.config.map_run + " map, " + r.config;
+    writeViewPage(s, out / "view.html");
+    return "view.html";
+  }
+#else
+  (void)e;
+  (void)out;
+#endif
+  return "";
+}
 
 int runDemo(const CliArgs& a) {
   const auto start = std::chrono::steady_clock::now();
@@ -47,6 +72,7 @@ int runDemo(const CliArgs& a) {
   context.command = "semsegmap demo";
   for (const std::string& arg : a.args()) context.command += " " + arg;
   context.pictures = {"overview.png"};
+  context.view = writeDemoView(e, out);
   context.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   writeBytesAtomically(out / "report.md", paperReport(context, nullptr, nullptr, &e));
   std::printf("wrote %s with its pictures in %.1f min\n", (out / "report.md").string().c_str(),

@@ -184,6 +184,8 @@ int runEvalRevisits(const CliArgs& a) {
   try {
     c.map_frames = parseFrameRanges(a.get("map-frames"), "option --map-frames");
     c.query_frames = parseFrameRanges(a.get("query-frames"), "option --query-frames");
+    if (a.has("wake-up")) parseWakeUp(a.get("wake-up"), "option --wake-up", c);
+    c.check_ground_truth = a.has("check-ground-truth");
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
@@ -271,6 +273,13 @@ const std::vector<const CommandSpec*>& evalCommands() {
             "the configurations compared (default: the shipped real-data ones)"},
            {"place-radius", Value::kNumber, "M", "10",
             "a query frame this close to a mapped frame is at a revisit"},
+           {"check-ground-truth", Value::kFlag, "", "",
+            "register each revisit scan to the mapped scans from its ground-truth pose: how far "
+            "the ground truth disagrees with the map's geometry, and the errors against the "
+            "registered poses"},
+           {"wake-up", Value::kText, "N[/EVERY]", "",
+            "the kidnapped robot: wake up at every EVERY-th query frame (default N) with an "
+            "empty local map and localize from the N frames from there"},
            kOut}),
       "", runEvalRevisits};
   static const CommandSpec paper{

@@ -1,5 +1,5 @@
 // semsegmap localize: localizes a run against a saved target map; writes localizations.csv,
-// summary.json and a bird's-eye picture.
+// matches.csv and trajectory.csv (for semsegmap view), summary.json and a bird's-eye picture.
 #include <filesystem>
 #include <iostream>
 
@@ -9,6 +9,7 @@
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/localization_picture.h"
 #include "semsegmap/io/config.h"
+#include "semsegmap/io/localization_details.h"
 #include "semsegmap/io/map_file.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/io/run_output.h"
@@ -23,10 +24,11 @@ int runLocalize(const CliArgs& a) {
   const std::filesystem::path map_path = a.get("map");
   const std::filesystem::path out = a.get("out");
   const auto map = std::make_shared<const TargetMap>(loadTargetMap(map_path));
-  std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
+  requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
+  auto source = openDatasetArg(a);
+  std::shared_ptr<Describer> describer = describerFor(config.descriptor, *source);
   checkMapCompatible(map_path, *map, descriptorName(describer->kind()), describer->fingerprint(),
                      describer->dimension());
-  auto source = openDatasetArg(a);
   std::filesystem::create_directories(out);
 
   Progress progress("localize", 0);
@@ -36,6 +38,7 @@ int runLocalize(const CliArgs& a) {
   const LocalizationRun run = runLocalization(*source, config, map, describer, options);
 
   writeLocalizationsCsv(out / "localizations.csv", run);
+  writeLocalizationDetails(out, run);  // matches.csv, trajectory.csv: for semsegmap view
   SummaryContext context;
   context.dataset = source->info().name;
   context.map = map_path.string();
@@ -59,7 +62,7 @@ int runLocalize(const CliArgs& a) {
         run.stats.frames, s.localizations, s.below_1m, s.below_5m, s.mean_translation_error_m,
         s.mean_rotation_error_deg, run.stats.fps());
   std::cout << "wrote " << (out / "localizations.csv").string()
-            << ", summary.json, localization.png\n";
+            << ", matches.csv, trajectory.csv, summary.json, localization.png\n";
   return 0;
 }
 

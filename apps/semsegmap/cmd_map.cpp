@@ -20,10 +20,11 @@ int runMap(const CliArgs& a) {
   if (points > 65535)
     throw UsageError("option --points must be in 0..65535, got " + a.get("points"));
   PipelineConfig config = loadPipelineConfig(a.get("config"));
-  // The model first: a missing one, or a descriptor this build has not, fails before the data.
-  std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
   const std::filesystem::path out = a.get("out");
+  requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
   auto source = openDatasetArg(a);
+  // The model before any frame: a missing one, or a descriptor this build has not, fails first.
+  std::shared_ptr<Describer> describer = describerFor(config.descriptor, *source);
   const std::string poses = a.has("poses")                          ? a.get("poses")
                             : source->info().has_ground_truth_poses ? "gt"
                                                                     : "odom";

@@ -22,8 +22,9 @@ namespace {
 int runSlamCommand(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
   const std::filesystem::path out = a.get("out");
+  requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
   auto source = openDatasetArg(a);
-  std::shared_ptr<Describer> describer = makeDescriber(config.descriptor);
+  std::shared_ptr<Describer> describer = describerFor(config.descriptor, *source);
 
   Progress progress("slam", 0);
   RunOptions options;

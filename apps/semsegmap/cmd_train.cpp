@@ -150,6 +150,11 @@ TrainConfig trainConfig(const CliArgs& a) {
                                   " is not a probability in [0, 1]");
     config.augmentation.confused_section_probability = p;
   }
+  if (a.has("lidar-only")) {
+    if (config.net.kind != DescriptorKind::kSemSegMapNet)
+      throw UsageError("--lidar-only: only semsegmap-net sees colour and classes");
+    config.net.use_color = config.net.use_classes = false;
+  }
   validateNetConfig(config.net);  // before the long extraction, not after it
   return config;
 }
@@ -243,6 +248,9 @@ const CommandSpec& trainCommand() {
                shown([](const TrainConfig& c) {
                  return c.augmentation.confused_section_probability;
                })},
+          {"lidar-only", Value::kFlag, "", "",
+           "the network sees geometry only (no colour, no classes): the model for a LiDAR "
+           "without a camera (descriptor.model_lidar_only)"},
           {"points", Value::kPositive, "N", "",
            "points a segment is subsampled to " +
                shown([](const TrainConfig& c) { return c.net.num_points; })},

@@ -1,10 +1,13 @@
 #include "dataset_args.h"
 
 #include <algorithm>
+#include <iostream>
 
 #include "resources.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/config.h"
+#include "semsegmap/io/model_file.h"
+#include "semsegmap/pipeline/input_modalities.h"
 
 namespace semsegmap::app {
 
@@ -56,6 +59,13 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesys
   if (a.has("ground-truth")) options.ground_truth = a.get("ground-truth");
   if (a.has("kitti-calib")) options.kitti_calib = a.get("kitti-calib");
   return openDataset(a.get("dataset"), options);
+}
+
+std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,
+                                        const FrameSource& source) {
+  const DescriptorChoice choice = chooseDescriptor(descriptor, inputModalitiesOf(source.info()));
+  if (!choice.note.empty()) std::cerr << "note: " << choice.note << "\n";
+  return makeDescriber(choice.descriptor);
 }
 
 }  // namespace semsegmap::app

@@ -9,6 +9,8 @@
 
 #include "cli_args.h"
 #include "semsegmap/core/frame_source.h"
+#include "semsegmap/describe/descriptor.h"
+#include "semsegmap/pipeline/pipeline_config.h"
 
 namespace semsegmap::app {
 
@@ -24,5 +26,10 @@ std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<Opti
 // that take several (eval revisits); by default the command's --config.
 std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a,
                                             const std::filesystem::path& config = {});
+
+// The describer for the data `source` gives: descriptor.model, or descriptor.model_lidar_only
+// for a LiDAR without a camera (chooseDescriptor); what was chosen or assumed is printed.
+std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,
+                                        const FrameSource& source);
 
 }  // namespace semsegmap::app

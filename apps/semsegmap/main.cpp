@@ -28,6 +28,9 @@ const std::vector<const CommandSpec*>& commands() {
 #if SEMSEGMAP_WITH_TORCH
     c.push_back(&trainCommand());
 #endif
+#if SEMSEGMAP_WITH_VIEWER
+    c.push_back(&viewCommand());
+#endif
 #if SEMSEGMAP_WITH_SIM
     c.push_back(&demoCommand());
 #endif
@@ -53,6 +56,10 @@ const std::vector<AbsentCommand>& absentCommands() {
       a.push_back({"train", "SEMSEGMAP_WITH_TORCH",
                    "this build has no learned descriptors to train (built without libtorch, "
                    "reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)"});
+    if (!SEMSEGMAP_WITH_VIEWER)
+      a.push_back({"view", "SEMSEGMAP_WITH_VIEWER",
+                   "this build has no viewer (built without Node.js and npm: run "
+                   "scripts/setup.sh and reconfigure with -DSEMSEGMAP_WITH_VIEWER=ON)"});
     return a;
   }();
   return absent;

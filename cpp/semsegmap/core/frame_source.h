@@ -21,6 +21,10 @@ struct DatasetInfo {
   // is refused instead of reading identity poses.
   bool has_odometry = false;
   bool has_point_labels = false;
+  // Whether those labels carry classes; false: instance ids only (the simulator's `classes=0`,
+  // ground truth for training a descriptor for a LiDAR without a camera), so the scans carry
+  // no semantics.
+  bool point_labels_have_classes = true;
   // Point instance ids from here on are traffic (parked and moving cars): no landmarks, and
   // another run of the same place has other ones. 0: the dataset has no such range.
   uint16_t first_transient_instance = 0;

@@ -39,6 +39,14 @@ uint64_t parseUnsigned(const std::string& spec, const std::string& key, const st
   return v;
 }
 
+LidarModel lidarPresetOf(const std::string& spec, const std::string& name) {
+  try {
+    return lidarPreset(name);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("dataset '" + spec + "': lidar=" + name + ": " + e.what());
+  }
+}
+
 std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::string& args) {
   std::string preset = "full";
   uint64_t world_seed = 1;
@@ -65,6 +73,10 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
       preset = value;
     else if (key == "cameras")
       config.render_cameras = parseUnsigned(spec, key, value) != 0;
+    else if (key == "lidar")
+      config.rig.lidar = lidarPresetOf(spec, value);
+    else if (key == "classes")
+      config.point_classes = parseUnsigned(spec, key, value) != 0;
     else if (key == "sweep")
       config.lidar_sweep = parseUnsigned(spec, key, value) != 0;
     else if (key == "label_noise") {

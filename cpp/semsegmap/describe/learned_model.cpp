@@ -50,6 +50,10 @@ uint64_t mixConfig(const NetConfig& c, uint64_t h) {
     h = fnv1a64(sa, sizeof sa, h);
     h = fnv1a64(radii, sizeof radii, h);
   }
+  if (!c.use_color || !c.use_classes) {  // likewise: the shipped models used both
+    const uint8_t flags[] = {c.use_color, c.use_classes};
+    h = fnv1a64(flags, sizeof flags, h);
+  }
   return h;
 }
 

@@ -52,8 +52,9 @@ NetInput makeNetInput(const NetConfig& config, const std::vector<const EnrichedC
     in.target_occupancy = torch::empty({b, 1, r, r, r});
     at::parallel_for(0, b, 1, [&](int64_t begin, int64_t end) {
       for (int64_t i = begin; i < end; ++i) {
-        const PointNetSample s = makePointNetSample(
-            *segments[i], config.num_points, config.num_classes, config.recon_grid, salts[i]);
+        const PointNetSample s =
+            makePointNetSample(*segments[i], config.num_points, config.num_classes,
+                               config.recon_grid, salts[i], config.use_color, config.use_classes);
         copyInto(in.points, i, s.points);
         copyInto(in.class_grid, i, s.class_grid);
         in.scale.data_ptr<float>()[i] = s.scale;

@@ -30,6 +30,11 @@ struct NetConfig {
   int sa2_divisor = 16;
   float sa2_radius = 0.4f;
   int sa_neighbours = 16;
+  // The modalities the network sees (semsegmap-net). Off, every point enters without colour or
+  // as of class unknown: a model trained so serves a LiDAR without a camera, and sees the same
+  // input from data that has them. Model files before format version 3 used both.
+  bool use_color = true;
+  bool use_classes = true;
 };
 
 // Throws std::invalid_argument naming the field when a value is out of range (e.g. a grid size

@@ -107,7 +107,7 @@ std::vector<uint32_t> hashSubsample(const EnrichedCloud& points, int count, uint
 }
 
 PointNetSample makePointNetSample(const EnrichedCloud& points, int num_points, int num_classes,
-                                  int recon_grid, uint64_t salt) {
+                                  int recon_grid, uint64_t salt, bool use_color, bool use_classes) {
   requireNonEmpty(points, "makePointNetSample");
   const Eigen::Vector3d c = centroidOf(points);
   double max_distance = 0;
@@ -131,7 +131,8 @@ PointNetSample makePointNetSample(const EnrichedCloud& points, int num_points, i
     row[0] = static_cast<float>((p.x - c.x()) / scale);
     row[1] = static_cast<float>((p.y - c.y()) / scale);
     row[2] = static_cast<float>((p.z - c.z()) / scale);
-    const std::array<float, 3> color = colorFeatures(p);
+    const std::array<float, 3> color =
+        use_color ? colorFeatures(p) : std::array<float, 3>{0.0f, 0.0f, 0.0f};
     std::copy(color.begin(), color.end(), row + 3);
   }
 
@@ -146,7 +147,7 @@ PointNetSample makePointNetSample(const EnrichedCloud& points, int num_points, i
       cell[a] = size > 0 ? cellOf(q[a], lo[a], size, 3) : 1;
     }
     const int flat = (cell[0] * 3 + cell[1]) * 3 + cell[2];
-    const int cls = std::min<int>(p.class_id, num_classes - 1);
+    const int cls = use_classes ? std::min<int>(p.class_id, num_classes - 1) : cls::kUnknown;
     counts[static_cast<size_t>(cls) * 27 + flat] += 1.0;
     totals[flat] += 1.0;
   }

@@ -29,9 +29,12 @@ struct PointNetSample {
 // a uniformly random subset for a random salt, yet a pure function of the point set (the input
 // order does not matter) for a fixed one. A segment with fewer points repeats them cyclically.
 // Centroid, scale, class grid and occupancy use every point. Throws std::invalid_argument on an
-// empty segment.
+// empty segment. Without `use_color` every point enters as seen by no camera, without
+// `use_classes` as of class unknown: a model for a LiDAR without a camera sees the same input
+// whatever the data carries (NetConfig::use_color, use_classes).
 PointNetSample makePointNetSample(const EnrichedCloud& points, int num_points, int num_classes,
-                                  int recon_grid, uint64_t salt);
+                                  int recon_grid, uint64_t salt, bool use_color = true,
+                                  bool use_classes = true);
 
 // Indices of the subsample described above (exposed for tests).
 std::vector<uint32_t> hashSubsample(const EnrichedCloud& points, int count, uint64_t salt);

@@ -4,6 +4,7 @@
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/localization_picture.h"
+#include "semsegmap/io/localization_details.h"
 #include "semsegmap/io/map_file.h"
 
 namespace semsegmap {
@@ -50,6 +51,7 @@ void writeLocalizationRunFiles(const std::filesystem::path& dir, const Localizat
                                const std::string& title) {
   std::filesystem::create_directories(dir);
   writeLocalizationsCsv(dir / "localizations.csv", run);
+  writeLocalizationDetails(dir, run);  // matches.csv, trajectory.csv: for semsegmap view
   context.descriptor = map.map->descriptor;
   context.map_segments = map.map->size();
   context.map_bytes = map.bytes;

@@ -41,8 +41,9 @@ std::vector<BuiltMap> finishMaps(std::vector<std::unique_ptr<MappingSession>>& s
 // configuration keeps (target_map.max_points_per_segment, 0: none), not the pictures'.
 BuiltMap saveBuiltMap(const std::filesystem::path& path, TargetMap built, size_t kept_points);
 
-// localizations.csv, summary.json and localization.png of one run in `dir`; the map's descriptor,
-// size and bytes are filled into `context`.
+// localizations.csv, matches.csv, trajectory.csv (io/localization_details.h), summary.json and
+// localization.png of one run in `dir`; the map's descriptor, size and bytes are filled into
+// `context`.
 void writeLocalizationRunFiles(const std::filesystem::path& dir, const LocalizationRun& run,
                                const BuiltMap& map, SummaryContext context,
                                const std::string& title);

@@ -176,6 +176,10 @@ std::string paperReport(const ReportContext& c, const SegmentationExperiment* se
        "direction and size of the differences, not for the counts themselves. SemSegMap and the "
        "SegMap baseline always run on the very same frames.\n\n";
   for (const std::string& p : c.pictures) r << "![" << p << "](" << p << ")\n\n";
+  if (!c.view.empty())
+    r << "In 3D: [" << c.view << "](" << c.view
+      << "), one file to open in any browser, offline: the map's segments, the trajectory and "
+         "every localization coloured by its error; click one to see its matched segments.\n\n";
   if (segmentation) r << segmentationSection(*segmentation);
   if (descriptors) r << descriptorSection(*descriptors);
   if (localization) r << localizationSection(*localization);

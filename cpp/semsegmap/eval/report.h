@@ -17,6 +17,7 @@ struct ReportContext {
   std::string command;  // how the report was made
   double seconds = 0.0;
   std::vector<std::string> pictures;  // extra pictures (relative paths) shown first
+  std::string view;                   // a page of `semsegmap view` (relative path), linked first
 };
 
 // The commit of the working directory's repository ("unknown" outside one; "+changes" when it

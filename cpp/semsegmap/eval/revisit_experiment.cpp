@@ -8,10 +8,12 @@
 #include <stdexcept>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/eval/ground_truth_check.h"
 #include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/localization_metrics.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/io/run_output.h"
+#include "semsegmap/pipeline/input_modalities.h"
 #include "semsegmap/viz/plot.h"
 
 namespace semsegmap {
@@ -78,6 +80,11 @@ void checkRevisitInput(const FrameSource& source, const RevisitExperimentConfig&
   if (!both.empty())
     throw std::invalid_argument("eval revisits: frame " + std::to_string(both.front()) +
                                 " is both mapped and queried; the ranges must not overlap");
+  size_t listed = 0;
+  for (const FrameRange& r : cfg.query_frames) listed += r.last - r.first + 1;
+  if (cfg.wake_up_frames > 0 && listed != queried.size())
+    throw std::invalid_argument(
+        "eval revisits: with wake-ups the query ranges must not overlap each other");
 }
 
 // The map frames, read once for every configuration, on ground-truth poses; their ground-truth
@@ -86,7 +93,7 @@ std::vector<BuiltMap> buildMaps(FrameSource& source, const RevisitExperimentConf
                                 const std::vector<std::shared_ptr<Describer>>& describers,
                                 const std::filesystem::path& out,
                                 std::vector<Eigen::Vector3d>& mapped_positions,
-                                const ExperimentProgress& progress) {
+                                const ExperimentProgress& progress, GroundTruthCheck* check) {
   FrameSubset frames(source, framesOf(cfg.map_frames));
   auto sessions =
       mappingSessions(cfg.configs, source.info(), describers, cfg.picture_points_per_segment);
@@ -96,9 +103,33 @@ std::vector<BuiltMap> buildMaps(FrameSource& source, const RevisitExperimentConf
                                std::to_string(frames.datasetFrame(frame.index)) +
                                " has no ground-truth pose");
     mapped_positions.push_back(frame.T_world_base->translation());
+    if (check) check->addMapped(frame.points, *frame.T_world_base * source.info().rig.T_base_lidar);
     for (auto& s : sessions) s->process(frame);
   });
   return finishMaps(sessions, cfg.configs, out);
+}
+
+// How soon each wake-up was localized; a session's localizations are in frame order.
+std::vector<WakeUp> wakeUpsOf(const RevisitExperiment& e, const LocalizationRun& run) {
+  std::vector<WakeUp> out;
+  if (e.config.wake_up_frames == 0) return out;
+  for (const std::vector<FrameRange>& session : querySessions(e.config)) {
+    WakeUp w;
+    w.frames = session.front();
+    const auto q = std::find_if(e.queries.begin(), e.queries.end(),
+                                [&](const RevisitFrame& f) { return f.frame == w.frames.first; });
+    w.revisit = q != e.queries.end() && q->revisit;
+    for (const LocalizationRecord& l : run.localizations) {
+      if (l.frame_index < w.frames.first || l.frame_index > w.frames.last) continue;
+      if (l.translation_error_m < e.config.correct_m) {
+        w.localized = l.frame_index - w.frames.first + 1;
+        break;
+      }
+      w.wrong_first = w.wrong_first || l.translation_error_m > e.config.wrong_m;
+    }
+    out.push_back(w);
+  }
+  return out;
 }
 
 RevisitResult resultOf(const RevisitExperiment& e, const NamedConfig& config,
@@ -120,7 +151,23 @@ RevisitResult resultOf(const RevisitExperiment& e, const NamedConfig& config,
                                 [&](const RevisitFrame& f) { return f.frame == l.frame_index; });
     r.revisits_localized +=
         q != e.queries.end() && q->revisit && l.translation_error_m < e.config.correct_m;
+    if (q != e.queries.end() && q->T_world_base_registered) {
+      const double error =
+          (l.T_map_base.translation() - q->T_world_base_registered->translation()).norm();
+      const double angle = rotationErrorDeg(l.T_map_base, *q->T_world_base_registered);
+      r.localizations.back().registered_error_m = error;
+      r.localizations.back().registered_rotation_error_deg = angle;
+      ++r.registered_compared;
+      r.registered_below_0_3m += error < 0.3 && angle < 1.0;
+      r.mean_registered_error_m += error;
+      r.mean_registered_rotation_error_deg += angle;
+    }
   }
+  if (r.registered_compared > 0) {
+    r.mean_registered_error_m /= static_cast<double>(r.registered_compared);
+    r.mean_registered_rotation_error_deg /= static_cast<double>(r.registered_compared);
+  }
+  r.wake_ups = wakeUpsOf(e, run);
   const LocalizationSummary s = summarize(run.localizations);
   r.mean_translation_error_m = s.mean_translation_error_m;
   r.mean_rotation_error_deg = s.mean_rotation_error_deg;
@@ -137,38 +184,76 @@ void writeRunFiles(const NamedConfig& config, const LocalizationRun& run, const 
                             e.dataset + ": revisits against its own map, " + config.name);
 }
 
-// The query frames, read once for every configuration, on the dataset's odometry.
+// Where a query frame lies against the mapped ones, noted once for every configuration.
+void noteQuery(RevisitExperiment& e, size_t dataset_frame, const Frame& frame,
+               const std::vector<Eigen::Vector3d>& mapped_positions, const Pose& T_base_lidar,
+               const GroundTruthCheck* check) {
+  RevisitFrame q;
+  q.frame = dataset_frame;
+  q.nearest_mapped_m = std::numeric_limits<double>::infinity();
+  if (frame.T_world_base)
+    for (const Eigen::Vector3d& p : mapped_positions)
+      q.nearest_mapped_m =
+          std::min(q.nearest_mapped_m, (frame.T_world_base->translation() - p).norm());
+  q.revisit = q.nearest_mapped_m <= e.config.place_radius_m;
+  e.revisits += q.revisit;
+  if (check) {  // every query frame: one farther than place_radius_m may still overlap the map
+    if (const auto T = check->registered(frame.points, *frame.T_world_base * T_base_lidar)) {
+      q.T_world_base_registered = *T * T_base_lidar.inverse();
+      q.ground_truth_correction_m =
+          (q.T_world_base_registered->translation() - frame.T_world_base->translation()).norm();
+      e.mean_correction_m += q.ground_truth_correction_m;
+      e.max_correction_m = std::max(e.max_correction_m, q.ground_truth_correction_m);
+      ++e.registered;
+    }
+  }
+  e.queries.push_back(q);
+}
+
+void appendRun(LocalizationRun& all, LocalizationRun run) {
+  for (LocalizationRecord& l : run.localizations) all.localizations.push_back(std::move(l));
+  all.trajectory_gt.insert(all.trajectory_gt.end(), run.trajectory_gt.begin(),
+                           run.trajectory_gt.end());
+  all.trajectory_odom.insert(all.trajectory_odom.end(), run.trajectory_odom.begin(),
+                             run.trajectory_odom.end());
+  all.distance_m += run.distance_m;
+  all.stats.frames += run.stats.frames;
+  all.stats.total += run.stats.total;
+}
+
+// The query frames, read once for every configuration, on the dataset's odometry: one session
+// over them all, or with wake-ups a fresh one (an empty local map) each.
 void localizeQueries(FrameSource& source, RevisitExperiment& e,
                      const std::vector<std::shared_ptr<Describer>>& describers,
                      const std::vector<BuiltMap>& maps,
                      const std::vector<Eigen::Vector3d>& mapped_positions,
-                     const std::filesystem::path& out, const ExperimentProgress& progress) {
+                     const std::filesystem::path& out, const ExperimentProgress& progress,
+                     const GroundTruthCheck* check) {
   const RevisitExperimentConfig& cfg = e.config;
-  FrameSubset frames(source, framesOf(cfg.query_frames));
-  std::vector<std::unique_ptr<LocalizationSession>> sessions;
-  for (size_t c = 0; c < cfg.configs.size(); ++c)
-    sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source.info(),
-                                                             maps[c].map, describers[c]));
-  forEachFrame(frames, "localize", progress, [&](const Frame& frame) {
-    RevisitFrame q;
-    q.frame = frames.datasetFrame(frame.index);
-    q.nearest_mapped_m = std::numeric_limits<double>::infinity();
-    if (frame.T_world_base)
-      for (const Eigen::Vector3d& p : mapped_positions)
-        q.nearest_mapped_m =
-            std::min(q.nearest_mapped_m, (frame.T_world_base->translation() - p).norm());
-    q.revisit = q.nearest_mapped_m <= cfg.place_radius_m;
-    e.revisits += q.revisit;
-    e.queries.push_back(q);
-    for (auto& s : sessions) s->process(frame);
-  });
+  std::vector<LocalizationRun> runs(cfg.configs.size());
+  for (const std::vector<FrameRange>& ranges : querySessions(cfg)) {
+    FrameSubset frames(source, framesOf(ranges));
+    std::vector<std::unique_ptr<LocalizationSession>> sessions;
+    for (size_t c = 0; c < cfg.configs.size(); ++c)
+      sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source.info(),
+                                                               maps[c].map, describers[c]));
+    forEachFrame(frames, "localize", progress, [&](const Frame& frame) {
+      noteQuery(e, frames.datasetFrame(frame.index), frame, mapped_positions,
+                source.info().rig.T_base_lidar, check);
+      for (auto& s : sessions) s->process(frame);
+    });
+    for (size_t c = 0; c < cfg.configs.size(); ++c) {
+      LocalizationRun run = sessions[c]->take();
+      // Reported under the dataset's frame numbers, not the subset's.
+      for (LocalizationRecord& l : run.localizations)
+        l.frame_index = frames.datasetFrame(l.frame_index);
+      appendRun(runs[c], std::move(run));
+    }
+  }
+  if (e.registered > 0) e.mean_correction_m /= static_cast<double>(e.registered);
   for (size_t c = 0; c < cfg.configs.size(); ++c) {
-    LocalizationRun run = sessions[c]->take();
-    // Reported under the dataset's frame numbers, not the subset's.
-    for (LocalizationRecord& l : run.localizations)
-      l.frame_index = frames.datasetFrame(l.frame_index);
-    e.results.push_back(resultOf(e, cfg.configs[c], run, maps[c]));
-    writeRunFiles(cfg.configs[c], run, maps[c], e, out);
+    e.results.push_back(resultOf(e, cfg.configs[c], runs[c], maps[c]));
+    writeRunFiles(cfg.configs[c], runs[c], maps[c], e, out);
   }
 }
 
@@ -178,9 +263,20 @@ nlohmann::ordered_json toJson(const RevisitResult& r) {
     loc.push_back({{"frame", l.frame},
                    {"inliers", l.inliers},
                    {"translation_error_m", l.translation_error_m},
-                   {"rotation_error_deg", l.rotation_error_deg}});
+                   {"rotation_error_deg", l.rotation_error_deg},
+                   {"registered_error_m", l.registered_error_m},
+                   {"registered_rotation_error_deg", l.registered_rotation_error_deg}});
+  nlohmann::ordered_json wake = nlohmann::ordered_json::array();
+  for (const WakeUp& w : r.wake_ups)
+    wake.push_back({{"first", w.frames.first},
+                    {"last", w.frames.last},
+                    {"revisit", w.revisit},
+                    {"localized_at_frame", w.localized},
+                    {"wrong_first", w.wrong_first}});
   return {{"config", r.config},
           {"descriptor", r.descriptor},
+          {"model", r.model},
+          {"model_note", r.model_note},
           {"map_segments", r.map_segments},
           {"map_bytes", r.map_bytes},
           {"n_localizations", r.localizations.size()},
@@ -191,7 +287,12 @@ nlohmann::ordered_json toJson(const RevisitResult& r) {
           {"mean_translation_error_m", r.mean_translation_error_m},
           {"mean_rotation_error_deg", r.mean_rotation_error_deg},
           {"n_revisits_localized", r.revisits_localized},
+          {"n_registered_compared", r.registered_compared},
+          {"n_registered_below_0_3m", r.registered_below_0_3m},
+          {"mean_registered_error_m", r.mean_registered_error_m},
+          {"mean_registered_rotation_error_deg", r.mean_registered_rotation_error_deg},
           {"dir", r.dir.string()},
+          {"wake_ups", wake},
           {"localizations", loc}};
 }
 
@@ -199,6 +300,49 @@ std::vector<double> errorsOf(const RevisitResult& r) {
   std::vector<double> errors;
   for (const RevisitLocalization& l : r.localizations) errors.push_back(l.translation_error_m);
   return errors;
+}
+
+// The ground truth against the map's geometry, and the localizations against the registered one.
+std::string groundTruthCheckText(const RevisitExperiment& e) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "\nground truth check: %zu of %zu query scans registered to the mapped scans; "
+                "registration moved their ground truth by %.2f m on average (at most %.2f m)\n",
+                e.registered, e.queries.size(), e.mean_correction_m, e.max_correction_m);
+  std::string out = line;
+  for (const RevisitResult& r : e.results) {
+    std::snprintf(line, sizeof line,
+                  "%s: against the registered ground truth, %zu of %zu localizations within "
+                  "0.3 m and 1 deg, mean error %.2f m / %.2f deg\n",
+                  r.config.c_str(), r.registered_below_0_3m, r.registered_compared,
+                  r.mean_registered_error_m, r.mean_registered_rotation_error_deg);
+    if (r.registered_compared > 0) out += line;
+  }
+  return out;
+}
+
+// The table's "localized by frame k" columns: 1, 2, 3, 5, 10, ... up to the wake-ups' length.
+std::vector<size_t> wakeUpColumns(size_t frames) {
+  std::vector<size_t> out;
+  for (const size_t k : {1, 2, 3, 5, 10, 20, 50})
+    if (k < frames) out.push_back(k);
+  out.push_back(frames);
+  return out;
+}
+
+// Counted over the wake-ups at a revisit: elsewhere the map holds nothing to localize against.
+std::string wakeUpRow(const RevisitResult& r, const std::vector<size_t>& by) {
+  size_t at_revisit = 0, wrong = 0;
+  std::vector<size_t> localized(by.size(), 0);
+  for (const WakeUp& w : r.wake_ups) {
+    if (!w.revisit) continue;
+    ++at_revisit;
+    wrong += w.wrong_first;
+    for (size_t i = 0; i < by.size(); ++i) localized[i] += w.localized > 0 && w.localized <= by[i];
+  }
+  std::string row = "| " + r.config + " | " + std::to_string(at_revisit) + " |";
+  for (const size_t n : localized) row += " " + std::to_string(n) + " |";
+  return row + " " + std::to_string(wrong) + " |";
 }
 
 }  // namespace
@@ -225,6 +369,32 @@ std::vector<FrameRange> parseFrameRanges(const std::string& text, const std::str
   return ranges;
 }
 
+void parseWakeUp(const std::string& text, const std::string& what, RevisitExperimentConfig& c) {
+  const size_t slash = text.find('/');
+  auto number = [&](const std::string& s) {
+    if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos ||
+        std::stoul(s) == 0)
+      throw std::invalid_argument(what + ": '" + text +
+                                  "' is not N[/EVERY] of positive frame counts");
+    return static_cast<size_t>(std::stoul(s));
+  };
+  c.wake_up_frames = number(text.substr(0, slash));
+  c.wake_up_every = slash == std::string::npos ? 0 : number(text.substr(slash + 1));
+  if (c.wake_up_every != 0 && c.wake_up_every < c.wake_up_frames)
+    throw std::invalid_argument(what + ": " + text +
+                                " would wake up again before the last wake-up's frames end");
+}
+
+std::vector<std::vector<FrameRange>> querySessions(const RevisitExperimentConfig& c) {
+  if (c.wake_up_frames == 0) return {c.query_frames};
+  const size_t every = c.wake_up_every ? c.wake_up_every : c.wake_up_frames;
+  std::vector<std::vector<FrameRange>> out;
+  for (const FrameRange& r : c.query_frames)
+    for (size_t first = r.first; first <= r.last; first += every)
+      out.push_back({FrameRange{first, std::min(first + c.wake_up_frames - 1, r.last)}});
+  return out;
+}
+
 RevisitExperiment evaluateRevisits(FrameSource& source, const RevisitExperimentConfig& cfg,
                                    const std::filesystem::path& out,
                                    const ExperimentProgress& progress) {
@@ -234,13 +404,26 @@ RevisitExperiment evaluateRevisits(FrameSource& source, const RevisitExperimentC
   e.dataset = source.info().name;
   for (int i = 0; i <= 100; ++i) e.thresholds.push_back(cfg.wrong_m * i / 100.0);
   std::filesystem::create_directories(out / "maps");
-  // Models load first: a missing one fails before the frames are read.
+  // Models load first: a missing one fails before the frames are read. Map and queries come
+  // from one recording, so one model suits both.
+  const InputModalities input = inputModalitiesOf(source.info());
+  std::vector<DescriptorChoice> choices;
   std::vector<std::shared_ptr<Describer>> describers;
-  for (const NamedConfig& c : cfg.configs) describers.push_back(makeDescriber(c.config.descriptor));
+  for (const NamedConfig& c : cfg.configs) {
+    choices.push_back(chooseDescriptor(c.config.descriptor, input));
+    describers.push_back(makeDescriber(choices.back().descriptor));
+  }
   std::vector<Eigen::Vector3d> mapped_positions;
+  std::optional<GroundTruthCheck> check;
+  if (cfg.check_ground_truth) check.emplace();
+  GroundTruthCheck* checking = check ? &*check : nullptr;
   const std::vector<BuiltMap> maps =
-      buildMaps(source, cfg, describers, out, mapped_positions, progress);
-  localizeQueries(source, e, describers, maps, mapped_positions, out, progress);
+      buildMaps(source, cfg, describers, out, mapped_positions, progress, checking);
+  localizeQueries(source, e, describers, maps, mapped_positions, out, progress, checking);
+  for (size_t c = 0; c < e.results.size(); ++c) {
+    e.results[c].model = choices[c].descriptor.model;
+    e.results[c].model_note = choices[c].note;
+  }
   return e;
 }
 
@@ -257,12 +440,21 @@ nlohmann::ordered_json toJson(const RevisitExperiment& e) {
   j["place_radius_m"] = e.config.place_radius_m;
   j["correct_m"] = e.config.correct_m;
   j["wrong_m"] = e.config.wrong_m;
+  j["wake_up_frames"] = e.config.wake_up_frames;
+  j["wake_up_every"] = e.config.wake_up_every;
   j["n_queries"] = e.queries.size();
   j["n_revisits"] = e.revisits;
   j["queries"] = nlohmann::ordered_json::array();
-  for (const RevisitFrame& q : e.queries)
-    j["queries"].push_back(
-        {{"frame", q.frame}, {"nearest_mapped_m", q.nearest_mapped_m}, {"revisit", q.revisit}});
+  j["check_ground_truth"] = e.config.check_ground_truth;
+  j["n_registered"] = e.registered;
+  j["mean_ground_truth_correction_m"] = e.mean_correction_m;
+  j["max_ground_truth_correction_m"] = e.max_correction_m;
+  for (const RevisitFrame& q : e.queries) {
+    nlohmann::ordered_json f = {
+        {"frame", q.frame}, {"nearest_mapped_m", q.nearest_mapped_m}, {"revisit", q.revisit}};
+    if (q.T_world_base_registered) f["ground_truth_correction_m"] = q.ground_truth_correction_m;
+    j["queries"].push_back(f);
+  }
   j["results"] = nlohmann::ordered_json::array();
   for (const RevisitResult& r : e.results) j["results"].push_back(toJson(r));
   return j;
@@ -304,6 +496,18 @@ std::string revisitTable(const RevisitExperiment& e) {
                   r.wrong, r.localizations.empty() ? "-" : mean, r.revisits_localized, e.revisits);
     t << line;
   }
+  if (e.config.check_ground_truth) t << groundTruthCheckText(e);
+  if (e.config.wake_up_frames > 0) {
+    t << "\n| config | wake-ups at a revisit |";
+    const std::vector<size_t> by = wakeUpColumns(e.config.wake_up_frames);
+    for (const size_t k : by) t << " localized by frame " << k << " |";
+    t << " first localization wrong |\n| --- | ---: |";
+    for (size_t i = 0; i <= by.size(); ++i) t << " ---: |";
+    t << "\n";
+    for (const RevisitResult& r : e.results) t << wakeUpRow(r, by) << "\n";
+  }
+  for (const RevisitResult& r : e.results)
+    if (!r.model_note.empty()) t << "\n" << r.config << ": " << r.model_note << "\n";
   return t.str();
 }
 

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,36 +34,73 @@ struct RevisitExperimentConfig {
   double correct_m = 1.0;  // a localization this close counts as localized at a revisit
   double wrong_m = 5.0;    // a localization farther off is wrong
   size_t picture_points_per_segment = 32;  // kept in memory for the pictures
+  // Wake-ups (the kidnapped robot), off at 0: a robot wakes up at every wake_up_every-th query
+  // frame of each range (0: every wake_up_frames-th, back to back) with an empty local map and
+  // localizes from that frame and the wake_up_frames - 1 after it (within the range).
+  size_t wake_up_frames = 0, wake_up_every = 0;
+  // Registers every query scan to the mapped scans from its ground-truth pose
+  // (eval/ground_truth_check.h): how far the ground truth disagrees with the map's own geometry,
+  // and each localization's error against the registered pose besides the recorded one.
+  bool check_ground_truth = false;
+};
+
+// "N[/EVERY]" of --wake-up; throws std::invalid_argument naming `what` and the text.
+void parseWakeUp(const std::string& text, const std::string& what, RevisitExperimentConfig& c);
+
+// The query frames as the sessions that localize them: one over every range, or with wake-ups
+// one a wake-up.
+std::vector<std::vector<FrameRange>> querySessions(const RevisitExperimentConfig& c);
+
+struct WakeUp {              // one wake-up of one configuration
+  FrameRange frames;         // the dataset's frames it localized from
+  bool revisit = false;      // its first frame is at a revisit
+  size_t localized = 0;      // 1 + frames after waking up until the first localization within
+                             // correct_m; 0: none
+  bool wrong_first = false;  // a localization more than wrong_m off came before any correct one
 };
 
 struct RevisitFrame {             // one query frame
   size_t frame = 0;               // the dataset's frame number
   double nearest_mapped_m = 0.0;  // ground-truth distance to the nearest mapped frame
   bool revisit = false;           // nearest_mapped_m <= place_radius_m
+  // check_ground_truth: the base pose registered to the mapped scans, when registration worked.
+  std::optional<Pose> T_world_base_registered;
+  double ground_truth_correction_m = 0.0;  // how far registration moved the ground truth
 };
 
 struct RevisitLocalization {
   size_t frame = 0;  // the dataset's frame number
   int inliers = 0;
   double translation_error_m = 0.0, rotation_error_deg = 0.0;
+  double registered_error_m = -1.0;  // against the registered ground truth; < 0: none
+  double registered_rotation_error_deg = -1.0;
 };
 
 struct RevisitResult {  // one configuration
   std::string config, descriptor;
+  std::string model;  // the model file the input's modalities chose (chooseDescriptor); or empty
+  std::string model_note;  // why that model, when the configuration names more than one
   size_t map_segments = 0;
   uint64_t map_bytes = 0;
   std::vector<RevisitLocalization> localizations;
   size_t below_0_5m = 0, below_1m = 0, below_5m = 0, wrong = 0;
   double mean_translation_error_m = 0.0, mean_rotation_error_deg = 0.0;
   size_t revisits_localized = 0;  // revisit frames localized within correct_m
-  std::filesystem::path dir;      // its files, relative to the output directory
+  std::vector<WakeUp> wake_ups;   // with wake-ups only
+  // check_ground_truth: localizations with a registered ground truth, and their errors to it.
+  size_t registered_compared = 0;
+  size_t registered_below_0_3m = 0;  // and 1 degree: the real-data target
+  double mean_registered_error_m = 0.0, mean_registered_rotation_error_deg = 0.0;
+  std::filesystem::path dir;  // its files, relative to the output directory
 };
 
 struct RevisitExperiment {
   RevisitExperimentConfig config;
   std::string dataset;
   std::vector<RevisitFrame> queries;
-  size_t revisits = 0;  // query frames at a revisit
+  size_t revisits = 0;    // query frames at a revisit
+  size_t registered = 0;  // check_ground_truth: query frames whose registration worked
+  double mean_correction_m = 0.0, max_correction_m = 0.0;
   std::vector<RevisitResult> results;
   std::vector<double> thresholds;  // of the cumulative curves, m
 };

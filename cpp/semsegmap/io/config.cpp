@@ -95,6 +95,8 @@ void checkPipelineConfig(const std::filesystem::path& path, const PipelineConfig
   check(c.enrichment.occlusion_radius_px >= 0,
         "enrichment.occlusion_radius_px: must not be negative");
   check(d.batch >= 1, "descriptor.batch: must be at least 1");
+  check(d.model_lidar_only.empty() || !d.model.empty(),
+        "descriptor.model_lidar_only: only for a learned descriptor (one with a model)");
   check(loc.localizer.index.k >= 1, "localization.k: must be at least 1");
   check(loc.localizer.verification.resolution_m > 0, "localization.resolution_m: must be positive");
   check(loc.localizer.verification.min_inliers >= 3,
@@ -263,8 +265,12 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
 
   auto& d = c.descriptor;
   readSection(path, root, "descriptor",
-              {{"kind", set(d.kind)}, {"model", set(d.model)}, {"batch", set(d.batch)}});
+              {{"kind", set(d.kind)},
+               {"model", set(d.model)},
+               {"model_lidar_only", set(d.model_lidar_only)},
+               {"batch", set(d.batch)}});
   d.model = besideConfig(path, d.model);
+  d.model_lidar_only = besideConfig(path, d.model_lidar_only);
   auto& loc = c.localization;
   readSection(path, root, "localization",
               {{"k", set(loc.localizer.index.k)},

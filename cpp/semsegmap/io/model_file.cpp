@@ -22,6 +22,14 @@ void putConfig(BinaryWriter& w, const NetConfig& c) {
   for (const int32_t f : {c.sa1_divisor, c.sa2_divisor, c.sa_neighbours}) w.put(f);
   w.put(c.sa1_radius);
   w.put(c.sa2_radius);
+  w.put(static_cast<uint8_t>(c.use_color));
+  w.put(static_cast<uint8_t>(c.use_classes));
+}
+
+bool getFlag(BinaryReader& r) {
+  const uint8_t v = r.get<uint8_t>("the configuration");
+  if (v > 1) r.fail("corrupt header: a modality flag of " + std::to_string(v));
+  return v == 1;
 }
 
 NetConfig getConfig(BinaryReader& r, DescriptorKind kind, uint32_t version) {
@@ -35,6 +43,10 @@ NetConfig getConfig(BinaryReader& r, DescriptorKind kind, uint32_t version) {
       *f = r.get<int32_t>("the configuration");
     c.sa1_radius = r.get<float>("the configuration");
     c.sa2_radius = r.get<float>("the configuration");
+  }
+  if (version >= 3) {
+    c.use_color = getFlag(r);
+    c.use_classes = getFlag(r);
   }
   try {
     validateNetConfig(c);

@@ -22,7 +22,7 @@ namespace semsegmap {
 
 class DescriptorNetImpl;
 
-constexpr uint32_t kModelFormatVersion = 2;
+constexpr uint32_t kModelFormatVersion = 3;
 
 // Written to a temporary name and renamed. Throws std::runtime_error naming the file.
 void writeModelFile(const std::filesystem::path& path, const Model& model);

@@ -18,6 +18,9 @@ struct DescriptorConfig {
   std::string kind = "semsegmap-net";  // descriptorName(): semsegmap-net, segmap-cnn, eigen, fpfh
   std::string model;  // model file of a learned descriptor; in YAML relative to the config file
   int batch = 64;     // segments described per forward pass
+  // Optional: the model taken instead for input with neither colour nor classes (a LiDAR
+  // without a camera; pipeline/input_modalities.h).
+  std::string model_lidar_only;
 };
 
 struct LocalizationConfig {

@@ -22,9 +22,11 @@ Simulator::Simulator(const SimConfig& config)
   config_.trajectory.rate_hz = config_.rig.rate_hz;
   trajectory_ = makeTrajectory(world_->roads, config.run, config_.trajectory, config_.odometry,
                                hashKeys(config.world.seed, static_cast<uint64_t>(config.run)));
-  info_.name = "sim world " + std::to_string(config.world.seed) + " run " + runName(config.run) +
-               " " + lighting_.name + " traffic " + std::to_string(traffic_seed_) +
-               (config.label_noise > 0 ? " label noise " + std::to_string(config.label_noise) : "");
+  info_.name =
+      "sim world " + std::to_string(config.world.seed) + " run " + runName(config.run) + " " +
+      lighting_.name + " traffic " + std::to_string(traffic_seed_) +
+      (config.label_noise > 0 ? " label noise " + std::to_string(config.label_noise) : "") +
+      (config.point_classes ? "" : " no point classes");
   label_noise_ = labelNoiseOfLevel(config.label_noise);
   info_.rig = config_.rig;
   if (!config_.render_cameras) info_.rig.cameras.clear();
@@ -32,6 +34,7 @@ Simulator::Simulator(const SimConfig& config)
   info_.has_ground_truth_poses = true;
   info_.has_odometry = true;  // the simulated drifting odometry
   info_.has_point_labels = true;
+  info_.point_labels_have_classes = config_.point_classes;
   info_.first_transient_instance = kTrafficInstanceBase;
 }
 
@@ -95,6 +98,8 @@ Frame Simulator::frame(size_t index) {
                        : simulateLidar(*scene_, config_.rig.lidar, T_world_lidar, seed);
   f.points = std::move(scan.points);
   f.point_labels = std::move(scan.labels);
+  if (!config_.point_classes)
+    for (PointLabel& l : f.point_labels) l.class_id = cls::kUnknown;
   f.point_times = std::move(scan.times);
   for (size_t c = 0; c < info_.rig.cameras.size(); ++c) {
     const Camera& cam = info_.rig.cameras[c];

@@ -34,6 +34,10 @@ struct SimConfig {
   // Imperfect camera labels (sim/label_noise.h): 0 perfect, up to 3 worse than a good Cityscapes
   // model. The LiDAR points' ground truth stays exact.
   int label_noise = 0;
+  // Off: the points' labels keep their instance ids but say class unknown, so that with
+  // render_cameras off a frame is what a LiDAR without a camera gives, while the instance ground
+  // truth that training needs is still there.
+  bool point_classes = true;
   double agent_clearance_m = 6.0;
 };
 

@@ -1,0 +1,125 @@
+// The pipeline configuration (pipeline/pipeline_config.h and the stages' config structs) and its
+// YAML reader (io/config.h). Fields are named as in the C++ structs; io/config.cpp maps the YAML
+// keys onto them (e.g. localization.k is localization.localizer.index.k).
+#include "bindings.h"
+#include "semsegmap/io/config.h"
+#include "semsegmap/pipeline/pipeline_config.h"
+
+namespace semsegmap::python {
+
+namespace {
+
+void bindFrontEndConfigs(py::module_& m) {
+  StructBinding<EnrichmentConfig>(m, "EnrichmentConfig", "enrich/enricher.h")
+      .field("occlusion_radius_px", &EnrichmentConfig::occlusion_radius_px)
+      .field("occlusion_tolerance_m", &EnrichmentConfig::occlusion_tolerance_m)
+      .field("occlusion_tolerance_rel", &EnrichmentConfig::occlusion_tolerance_rel);
+
+  py::enum_<DynamicRemoval>(m, "DynamicRemoval", "How dynamic points leave the local map")
+      .value("point", DynamicRemoval::kPoint)
+      .value("voxel", DynamicRemoval::kVoxel);
+  StructBinding<GroundRemovalConfig>(m, "GroundRemovalConfig", "local_map/ground_removal.h")
+      .field("cell_size_m", &GroundRemovalConfig::cell_size_m)
+      .field("neighbourhood_cells", &GroundRemovalConfig::neighbourhood_cells)
+      .field("height_above_m", &GroundRemovalConfig::height_above_m);
+  StructBinding<LocalMapConfig>(m, "LocalMapConfig", "local_map/local_map.h")
+      .field("voxel_size_m", &LocalMapConfig::voxel_size_m)
+      .field("radius_m", &LocalMapConfig::radius_m)
+      .field("min_points_per_voxel", &LocalMapConfig::min_points_per_voxel)
+      .field("remove_dynamic_classes", &LocalMapConfig::remove_dynamic_classes)
+      .field("dynamic_removal", &LocalMapConfig::dynamic_removal)
+      .field("dynamic_vote_share", &LocalMapConfig::dynamic_vote_share)
+      .field("remove_ground_classes", &LocalMapConfig::remove_ground_classes)
+      .field("remove_unknown_class", &LocalMapConfig::remove_unknown_class)
+      .field("geometric_ground_removal", &LocalMapConfig::geometric_ground_removal)
+      .field("ground", &LocalMapConfig::ground);
+
+  StructBinding<SegmentationConfig>(m, "SegmentationConfig", "segment/semantic_distance.h")
+      .field("d_segment_m", &SegmentationConfig::d_segment_m)
+      .field("hue_threshold", &SegmentationConfig::hue_threshold)
+      .field("hue_penalty", &SegmentationConfig::hue_penalty)
+      .field("class_penalty", &SegmentationConfig::class_penalty)
+      .field("min_segment_points", &SegmentationConfig::min_segment_points)
+      .field("max_segment_points", &SegmentationConfig::max_segment_points)
+      .field("observation_growth", &SegmentationConfig::observation_growth)
+      .field("keep_all_observation_points", &SegmentationConfig::keep_all_observation_points);
+
+  StructBinding<DescriptorConfig>(m, "DescriptorConfig", "pipeline/pipeline_config.h")
+      .field("kind", &DescriptorConfig::kind, "eigen | fpfh | segmap-cnn | semsegmap-net")
+      .field("model", &DescriptorConfig::model, "model file of a learned descriptor")
+      .field("model_lidar_only", &DescriptorConfig::model_lidar_only,
+             "the model taken instead for input with neither colour nor classes")
+      .field("batch", &DescriptorConfig::batch, "segments described per forward pass");
+}
+
+void bindLocalizationConfigs(py::module_& m) {
+  StructBinding<DescriptorIndexConfig>(m, "DescriptorIndexConfig", "localize/descriptor_index.h")
+      .field("k", &DescriptorIndexConfig::k)
+      .field("exact_below", &DescriptorIndexConfig::exact_below)
+      .field("ivf_lists", &DescriptorIndexConfig::ivf_lists)
+      .field("ivf_probes", &DescriptorIndexConfig::ivf_probes)
+      .field("ivf_training_iterations", &DescriptorIndexConfig::ivf_training_iterations);
+  using GV = GeometricVerificationConfig;
+  StructBinding<GV>(m, "GeometricVerificationConfig", "localize/geometric_verification.h")
+      .field("resolution_m", &GV::resolution_m)
+      .field("min_inliers", &GV::min_inliers)
+      .field("refine", &GV::refine)
+      .field("inlier_tolerance_m", &GV::inlier_tolerance_m)
+      .field("min_spread_m", &GV::min_spread_m)
+      .field("max_search_nodes", &GV::max_search_nodes);
+  StructBinding<LocalizerConfig>(m, "LocalizerConfig", "localize/localizer.h")
+      .field("index", &LocalizerConfig::index)
+      .field("verification", &LocalizerConfig::verification)
+      .field("min_local_segments", &LocalizerConfig::min_local_segments);
+  StructBinding<RefinementConfig>(m, "RefinementConfig", "localize/pose_refinement.h")
+      .field("enabled", &RefinementConfig::enabled)
+      .field("max_points_per_segment", &RefinementConfig::max_points_per_segment)
+      .field("coarse_distance_m", &RefinementConfig::coarse_distance_m)
+      .field("fine_distance_m", &RefinementConfig::fine_distance_m)
+      .field("kernel_scale_m", &RefinementConfig::kernel_scale_m)
+      .field("max_correction_m", &RefinementConfig::max_correction_m)
+      .field("min_correspondences", &RefinementConfig::min_correspondences);
+  StructBinding<LocalizationConfig>(m, "LocalizationConfig", "pipeline/pipeline_config.h")
+      .field("localizer", &LocalizationConfig::localizer)
+      .field("every_n_frames", &LocalizationConfig::every_n_frames)
+      .field("refinement", &LocalizationConfig::refinement);
+  using TMB = TargetMapBuilderConfig;
+  StructBinding<TMB>(m, "TargetMapBuilderConfig", "localize/target_map.h")
+      .field("duplicate_distance_m", &TMB::duplicate_distance_m)
+      .field("max_points_per_segment", &TMB::max_points_per_segment);
+  StructBinding<PoseGraphConfig>(m, "PoseGraphConfig", "graph/pose_graph.h")
+      .field("odometry_translation_sigma_m", &PoseGraphConfig::odometry_translation_sigma_m)
+      .field("odometry_rotation_sigma_rad", &PoseGraphConfig::odometry_rotation_sigma_rad)
+      .field("loop_translation_sigma_m", &PoseGraphConfig::loop_translation_sigma_m)
+      .field("loop_rotation_sigma_rad", &PoseGraphConfig::loop_rotation_sigma_rad)
+      .field("loop_robust_scale", &PoseGraphConfig::loop_robust_scale)
+      .field("max_iterations", &PoseGraphConfig::max_iterations)
+      .field("threads", &PoseGraphConfig::threads);
+  StructBinding<LoopClosureConfig>(m, "LoopClosureConfig", "pipeline/pipeline_config.h")
+      .field("exclude_recent_m", &LoopClosureConfig::exclude_recent_m)
+      .field("min_travel_between_loops_m", &LoopClosureConfig::min_travel_between_loops_m)
+      .field("graph", &LoopClosureConfig::graph);
+}
+
+}  // namespace
+
+void bindConfig(py::module_& m) {
+  bindFrontEndConfigs(m);
+  bindLocalizationConfigs(m);
+  StructBinding<PipelineConfig>(m, "PipelineConfig", "The whole pipeline's configuration")
+      .field("enrichment", &PipelineConfig::enrichment)
+      .field("local_map", &PipelineConfig::local_map)
+      .field("segmentation", &PipelineConfig::segmentation)
+      .field("descriptor", &PipelineConfig::descriptor)
+      .field("localization", &PipelineConfig::localization)
+      .field("target_map", &PipelineConfig::target_map)
+      .field("loop_closure", &PipelineConfig::loop_closure);
+  m.def(
+      "load_config", [](const std::filesystem::path& path) { return loadPipelineConfig(path); },
+      py::arg("path"),
+      "Reads a YAML config (config/*.yaml) as the command line does: descriptor.model relative "
+      "to the file; an unknown key, a wrong type or a bad value raises RuntimeError "
+      "'<file>: <section.key>: <what>'.");
+}
+
+}  // namespace semsegmap::python

@@ -1,0 +1,362 @@
+// pipeline/: the front end frame by frame (Pipeline), its results and local segments, and the
+// mapping and localization modes (pipeline/modes.h) by frame or over a whole dataset. Every call
+// that processes frames releases the GIL.
+#include <stdexcept>
+
+#include "bindings.h"
+#include "semsegmap/enrich/enricher.h"
+#include "semsegmap/pipeline/modes.h"
+#include "semsegmap/pipeline/pipeline.h"
+
+namespace semsegmap::python {
+
+namespace {
+
+// The local segment map as arrays, one row per segment in ascending id (the query's order).
+struct LocalSegments {
+  py::array ids, centroids, n_points, classes, frame_indices, descriptors;
+};
+
+// A MappingRun whose map can be shared with localizers (TargetMap is held by shared_ptr).
+struct MappingResult {
+  std::shared_ptr<TargetMap> map;
+  std::vector<Pose> trajectory;
+  size_t segments = 0, duplicates_removed = 0;
+  RunStats stats;
+};
+
+MappingResult resultOf(MappingRun&& run) {
+  return {std::make_shared<TargetMap>(std::move(run.map)), std::move(run.trajectory), run.segments,
+          run.duplicates_removed, run.stats};
+}
+
+std::shared_ptr<Describer> required(std::shared_ptr<Describer> d, const char* where) {
+  if (!d)
+    throw std::invalid_argument(std::string(where) + ": describer: required (make_describer)");
+  return d;
+}
+
+// The command line's default: ground truth when the dataset has it, else odometry.
+PoseSource posesFor(const py::object& poses, const DatasetInfo& info) {
+  if (poses.is_none())
+    return info.has_ground_truth_poses ? PoseSource::kGroundTruth : PoseSource::kOdometry;
+  return parsePoseSource(poses.cast<std::string>());
+}
+
+py::array_t<EnrichedPoint> cloudArray(EnrichedCloud cloud) {
+  return ownedArray(std::move(cloud));
+}
+
+// Descriptors (one vector each, all of one size) as an (M, D) matrix.
+Eigen::MatrixXf rowsOf(const std::vector<Eigen::VectorXf>& d) {
+  Eigen::MatrixXf m(static_cast<Eigen::Index>(d.size()), d.empty() ? 0 : d[0].size());
+  for (size_t i = 0; i < d.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = d[i].transpose();
+  return m;
+}
+
+LocalSegments localSegmentsOf(const Pipeline& p) {
+  const LocalSegmentQuery q = p.localSegmentQuery();
+  std::vector<uint32_t> n_points;
+  std::vector<ClassId> classes;
+  std::vector<uint64_t> frames;
+  for (SegmentId id : q.ids) {
+    const DescribedSegment& s = p.localSegments().at(id);
+    n_points.push_back(s.n_points);
+    classes.push_back(s.majority_class);
+    frames.push_back(s.frame_index);
+  }
+  std::vector<int64_t> ids(q.ids.begin(), q.ids.end());
+  return {ownedArray(std::move(ids)),      pointsArray(q.centroids),
+          ownedArray(std::move(n_points)), ownedArray(std::move(classes)),
+          ownedArray(std::move(frames)),   py::cast(q.descriptors)};
+}
+
+// The points of a local segment's described observation (map frame), a copy.
+py::array_t<EnrichedPoint> segmentPoints(const Pipeline& p, SegmentId id) {
+  const Segment* s = p.segmenter().segment(id);
+  if (!p.localSegments().count(id) || !s || s->observations.empty())
+    throw std::out_of_range("segment " + std::to_string(id) + " is not in the local segment map");
+  return cloudArray(s->last().points);
+}
+
+void bindResults(py::module_& m) {
+  py::class_<StageTimes>(m, "StageTimes", "Milliseconds per stage")
+      .def_readonly("enrich_ms", &StageTimes::enrich_ms)
+      .def_readonly("local_map_ms", &StageTimes::local_map_ms)
+      .def_readonly("segment_ms", &StageTimes::segment_ms)
+      .def_readonly("describe_ms", &StageTimes::describe_ms)
+      .def_readonly("localize_ms", &StageTimes::localize_ms)
+      .def_property_readonly("total_ms", &StageTimes::total);
+  py::class_<RunStats>(m, "RunStats", "Frames processed and the pipeline's time over them")
+      .def_readonly("frames", &RunStats::frames)
+      .def_readonly("total", &RunStats::total)
+      .def_property_readonly("fps", &RunStats::fps);
+
+  py::class_<SegmentObservation>(m, "SegmentObservation", "One observation of a segment")
+      .def_readonly("frame_index", &SegmentObservation::frame_index)
+      .def_readonly("timestamp_s", &SegmentObservation::timestamp_s)
+      .def_readonly("n_points", &SegmentObservation::n_points)
+      .def_readonly("centroid", &SegmentObservation::centroid, "(3,) float64, map frame")
+      .def_readonly("majority_class", &SegmentObservation::majority_class)
+      .def_readonly("gt_instance", &SegmentObservation::gt_instance)
+      .def_readonly("gt_purity", &SegmentObservation::gt_purity)
+      .def_property_readonly(
+          "points",
+          [](const py::object& self) {
+            const EnrichedCloud& c = self.cast<const SegmentObservation&>().points;
+            return py::array_t<EnrichedPoint>({c.size()}, {sizeof(EnrichedPoint)}, c.data(), self);
+          },
+          "ENRICHED_POINT_DTYPE view, map frame; empty for older observations unless kept");
+  py::class_<Segment>(m, "Segment", "A segment and its observations (segment/segment.h)")
+      .def_readonly("id", &Segment::id)
+      .def_readonly("first_frame", &Segment::first_frame)
+      .def_readonly("last_frame", &Segment::last_frame)
+      .def_readonly("observations", &Segment::observations)
+      .def_property_readonly(
+          "last", [](const Segment& s) -> const SegmentObservation& { return s.last(); },
+          py::return_value_policy::reference_internal, "the latest, most complete observation");
+
+  py::class_<FrameResult>(m, "FrameResult", "What the front end did with one frame")
+      .def_readonly("frame_index", &FrameResult::frame_index)
+      .def_property_readonly("T_local_base",
+                             [](const FrameResult& r) { return poseArray(r.T_local_base); })
+      .def_readonly("points", &FrameResult::points)
+      .def_readonly("colored_points", &FrameResult::colored_points)
+      .def_readonly("described", &FrameResult::described, "segments described this frame")
+      .def_readonly("times", &FrameResult::times)
+      .def_property_readonly("points_inserted",
+                             [](const FrameResult& r) { return r.map_update.points_inserted; })
+      .def_property_readonly("points_filtered",
+                             [](const FrameResult& r) { return r.map_update.points_filtered; })
+      .def_property_readonly("newly_active_voxels",
+                             [](const FrameResult& r) { return r.map_update.newly_active.size(); })
+      .def_property_readonly("removed_voxels",
+                             [](const FrameResult& r) { return r.map_update.removed.size(); })
+      .def_property_readonly(
+          "observed", [](const FrameResult& r) { return r.segmentation.observed; },
+          "ids of the segments observed anew")
+      .def_property_readonly(
+          "merges",
+          [](const FrameResult& r) {
+            std::vector<std::pair<SegmentId, SegmentId>> merges;
+            for (const SegmentMerge& g : r.segmentation.merges)
+              merges.emplace_back(g.absorbed, g.survivor);
+            return merges;
+          },
+          "(absorbed, survivor) id pairs")
+      .def_property_readonly(
+          "finished", [](const FrameResult& r) { return r.segmentation.finished; },
+          "the segments that left the local map (copies)")
+      .def_property_readonly(
+          "finished_descriptors",
+          [](const FrameResult& r) { return rowsOf(r.finished_descriptors); },
+          "(M, D): their final descriptors, parallel to finished");
+
+  py::class_<LocalSegments>(m, "LocalSegments",
+                            "The local segment map as arrays, one row per segment by ascending id")
+      .def_readonly("ids", &LocalSegments::ids, "(M,) int64")
+      .def_readonly("centroids", &LocalSegments::centroids, "(M, 3) float32, local map frame")
+      .def_readonly("n_points", &LocalSegments::n_points, "(M,) uint32")
+      .def_readonly("classes", &LocalSegments::classes, "(M,) uint16 majority class")
+      .def_readonly("frame_indices", &LocalSegments::frame_indices,
+                    "(M,) uint64: frame of the described observation")
+      .def_readonly("descriptors", &LocalSegments::descriptors, "(M, D) float32")
+      .def("__len__", [](const LocalSegments& s) { return s.ids.size(); });
+}
+
+void bindPipelineClass(py::module_& m) {
+  py::class_<Pipeline>(m, "Pipeline",
+                       "The front end frame by frame: enrich, local map, segment, describe")
+      .def(py::init([](const PipelineConfig& c, const DatasetInfo& info, const py::object& poses,
+                       std::shared_ptr<Describer> d) {
+             return std::make_unique<Pipeline>(c, info, posesFor(poses, info), std::move(d));
+           }),
+           py::arg("config"), py::arg("info"), py::arg("poses") = py::none(),
+           py::arg("describer") = nullptr,
+           "poses: 'gt' or 'odom' (default: gt when the dataset has it); no describer: segments "
+           "are not described")
+      .def(
+          "process",
+          [](Pipeline& p, const Frame& f) {
+            py::gil_scoped_release release;
+            return p.process(f);
+          },
+          py::arg("frame"))
+      .def(
+          "finish",
+          [](Pipeline& p) {
+            std::vector<Eigen::VectorXf> d;
+            std::vector<Segment> segments;
+            {
+              py::gil_scoped_release release;
+              segments = p.finish(p.describer() ? &d : nullptr);
+            }
+            return py::make_tuple(segments, rowsOf(d));
+          },
+          "End of the run: (segments still in the local map, finished; their descriptors)")
+      .def("local_segments", &localSegmentsOf, "The local segment map (LocalSegments)")
+      .def("segment_points", &segmentPoints, py::arg("id"),
+           "The described observation's points of local segment `id` (ENRICHED_POINT_DTYPE, a "
+           "copy); IndexError for an id not in the local segment map");
+  m.def(
+      "enrich_frame",
+      [](const Frame& f, const SensorRig& rig, const EnrichmentConfig& c) {
+        EnrichedCloud cloud;
+        {
+          py::gil_scoped_release release;
+          cloud = enrichFrame(f, rig, c);
+        }
+        return cloudArray(std::move(cloud));
+      },
+      py::arg("frame"), py::arg("rig"), py::arg("config") = EnrichmentConfig{},
+      "Colour and class of the camera pixels on each point (LiDAR frame), ENRICHED_POINT_DTYPE");
+}
+
+void bindMapping(py::module_& m) {
+  py::class_<MappingResult>(m, "MappingRun", "A target map built from a run")
+      .def_readonly("map", &MappingResult::map)
+      .def_property_readonly(
+          "trajectory", [](const MappingResult& r) { return posesArray(r.trajectory); },
+          "(N, 4, 4): the poses the map was built with")
+      .def_readonly("segments", &MappingResult::segments, "finished, before removing duplicates")
+      .def_readonly("duplicates_removed", &MappingResult::duplicates_removed)
+      .def_readonly("stats", &MappingResult::stats);
+  py::class_<MappingSession>(m, "MappingSession", "Builds a target map frame by frame")
+      .def(py::init([](const PipelineConfig& c, const DatasetInfo& info,
+                       std::shared_ptr<Describer> d, const py::object& poses) {
+             return std::make_unique<MappingSession>(c, info, posesFor(poses, info),
+                                                     required(std::move(d), "MappingSession"));
+           }),
+           py::arg("config"), py::arg("info"), py::arg("describer"), py::arg("poses") = py::none())
+      .def(
+          "process",
+          [](MappingSession& s, const Frame& f) {
+            py::gil_scoped_release release;
+            s.process(f);
+          },
+          py::arg("frame"))
+      .def(
+          "finish",
+          [](MappingSession& s) {
+            py::gil_scoped_release release;
+            return resultOf(s.finish());
+          },
+          "The map, once after the last frame");
+  m.def(
+      "run_mapping",
+      [](FrameSource& source, const PipelineConfig& c, std::shared_ptr<Describer> d,
+         const py::object& poses, size_t max_frames) {
+        const PoseSource p = posesFor(poses, source.info());
+        d = required(std::move(d), "run_mapping");
+        RunOptions options;
+        options.max_frames = max_frames;
+        py::gil_scoped_release release;
+        return resultOf(runMapping(source, c, p, std::move(d), options));
+      },
+      py::arg("dataset"), py::arg("config"), py::arg("describer"), py::arg("poses") = py::none(),
+      py::arg("max_frames") = 0,
+      "Maps the first max_frames frames (0: all), as `semsegmap map` does");
+}
+
+void bindLocalizationResults(py::module_& m) {
+  py::class_<LocalizationRecord>(m, "LocalizationRecord", "One localization of a run")
+      .def_readonly("frame_index", &LocalizationRecord::frame_index)
+      .def_readonly("timestamp_s", &LocalizationRecord::timestamp_s)
+      .def_property_readonly("T_map_base",
+                             [](const LocalizationRecord& l) { return poseArray(l.T_map_base); })
+      .def_readonly("inliers", &LocalizationRecord::inliers)
+      .def_readonly("candidates", &LocalizationRecord::candidates)
+      .def_property_readonly("T_world_base",
+                             [](const LocalizationRecord& l) -> py::object {
+                               if (!l.T_world_base) return py::none();
+                               return poseArray(*l.T_world_base);
+                             })
+      .def_readonly("translation_error_m", &LocalizationRecord::translation_error_m)
+      .def_readonly("rotation_error_deg", &LocalizationRecord::rotation_error_deg)
+      .def_property_readonly(
+          "matches",
+          [](const LocalizationRecord& l) {
+            py::array_t<float> a({l.matches.size(), size_t{2}, size_t{3}});
+            auto r = a.mutable_unchecked<3>();
+            for (size_t i = 0; i < l.matches.size(); ++i)
+              for (int j = 0; j < 3; ++j) {
+                r(i, 0, j) = l.matches[i].first[j];
+                r(i, 1, j) = l.matches[i].second[j];
+              }
+            return a;
+          },
+          "(K, 2, 3) float32: the local centroid carried into the map, the target's")
+      .def_readonly("refined", &LocalizationRecord::refined)
+      .def_readonly("refinement_correction_m", &LocalizationRecord::refinement_correction_m);
+  py::class_<LocalizationSummary>(m, "LocalizationSummary")
+      .def_readonly("localizations", &LocalizationSummary::localizations)
+      .def_readonly("below_1m", &LocalizationSummary::below_1m)
+      .def_readonly("below_5m", &LocalizationSummary::below_5m)
+      .def_readonly("mean_translation_error_m", &LocalizationSummary::mean_translation_error_m)
+      .def_readonly("mean_rotation_error_deg", &LocalizationSummary::mean_rotation_error_deg);
+  py::class_<LocalizationRun>(m, "LocalizationRun", "A run localized against a target map")
+      .def_readonly("localizations", &LocalizationRun::localizations)
+      .def_property_readonly("trajectory_gt",
+                             [](const LocalizationRun& r) { return posesArray(r.trajectory_gt); })
+      .def_property_readonly("trajectory_odom",
+                             [](const LocalizationRun& r) { return posesArray(r.trajectory_odom); })
+      .def_readonly("distance_m", &LocalizationRun::distance_m)
+      .def_readonly("stats", &LocalizationRun::stats)
+      .def("summary", [](const LocalizationRun& r) { return summarize(r.localizations); });
+  m.def("summarize", &summarize, py::arg("records"));
+}
+
+void bindLocalization(py::module_& m) {
+  bindLocalizationResults(m);
+  py::class_<LocalizationSession>(m, "LocalizationSession",
+                                  "Localizes a run frame by frame, on its odometry")
+      .def(py::init([](const PipelineConfig& c, const DatasetInfo& info,
+                       std::shared_ptr<TargetMap> map, std::shared_ptr<Describer> d) {
+             d = required(std::move(d), "LocalizationSession");
+             py::gil_scoped_release release;  // builds the map's descriptor index
+             return std::make_unique<LocalizationSession>(
+                 c, info, std::shared_ptr<const TargetMap>(std::move(map)), std::move(d));
+           }),
+           py::arg("config"), py::arg("info"), py::arg("map"), py::arg("describer"),
+           "RuntimeError when the map's descriptors are not the describer's")
+      .def(
+          "process",
+          [](LocalizationSession& s, const Frame& f) -> py::object {
+            const size_t before = s.run().localizations.size();
+            {
+              py::gil_scoped_release release;
+              s.process(f);
+            }
+            if (s.run().localizations.size() == before) return py::none();
+            return py::cast(s.run().localizations.back());
+          },
+          py::arg("frame"), "The LocalizationRecord this frame gave, or None")
+      .def_property_readonly(
+          "run", [](const LocalizationSession& s) { return LocalizationRun(s.run()); },
+          "the run so far (a copy)");
+  m.def(
+      "run_localization",
+      [](FrameSource& source, const PipelineConfig& c, std::shared_ptr<TargetMap> map,
+         std::shared_ptr<Describer> d, size_t max_frames) {
+        d = required(std::move(d), "run_localization");
+        RunOptions options;
+        options.max_frames = max_frames;
+        py::gil_scoped_release release;
+        return runLocalization(source, c, std::shared_ptr<const TargetMap>(std::move(map)),
+                               std::move(d), options);
+      },
+      py::arg("dataset"), py::arg("config"), py::arg("map"), py::arg("describer"),
+      py::arg("max_frames") = 0,
+      "Localizes the first max_frames frames (0: all), as `semsegmap localize` does");
+}
+
+}  // namespace
+
+void bindPipeline(py::module_& m) {
+  bindResults(m);
+  bindPipelineClass(m);
+  bindMapping(m);
+  bindLocalization(m);
+}
+
+}  // namespace semsegmap::python

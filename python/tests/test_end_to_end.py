@@ -1,0 +1,91 @@
+"""Map a simulated run and localize another from Python, and the command line on the very same
+input: the counts and the localizations must be the same. Then a revisit range of the mapped run
+localized frame by frame."""
+
+import csv
+import os
+import re
+
+import numpy as np
+import pytest
+
+import semsegmap as ssm
+from conftest import TINY_S1, TINY_S2, finish_cli, needs_sim, needs_torch, source_file, start_cli
+
+pytestmark = [needs_sim, needs_torch]  # the shipped config's describer is learned
+FRAMES = 60  # S1's first 60 frames are driven again from frame 395 on, and by S2
+QUERY_FRAMES = 40
+CONFIG = source_file("config/semsegmap.yaml")
+
+
+@pytest.fixture(scope="module")
+def describer(config):
+    return ssm.describer_for(config.descriptor, ssm.open_dataset(TINY_S1).info)
+
+
+@pytest.fixture(scope="module")
+def runs(binary, tmp_path_factory, config, describer):
+    """Each command beside its Python twin: the module releases the GIL, and each side keeps
+    about one core busy. Python localizes against the command line's map: the same input."""
+    work = str(tmp_path_factory.mktemp("e2e"))
+    cli_map = os.path.join(work, "cli.map")
+    mapping = start_cli(binary, "map", "--dataset", TINY_S1, "--config", CONFIG, "--max-frames",
+                        str(FRAMES), "--out", cli_map)
+    built = ssm.run_mapping(ssm.open_dataset(TINY_S1), config, describer, max_frames=FRAMES)
+    map_out = finish_cli(mapping)
+    localized = os.path.join(work, "localize")
+    localizing = start_cli(binary, "localize", "--dataset", TINY_S2, "--map", cli_map, "--config",
+                           CONFIG, "--max-frames", str(QUERY_FRAMES), "--out", localized)
+    run = ssm.run_localization(ssm.open_dataset(TINY_S2), config, ssm.load_map(cli_map),
+                               describer, max_frames=QUERY_FRAMES)
+    localize_out = finish_cli(localizing)
+    return dict(work=work, cli_map=cli_map, map_out=map_out, built=built, run=run,
+                localize_out=localize_out, csv=os.path.join(localized, "localizations.csv"))
+
+
+def test_mapping_counts_equal_the_command_lines(runs):
+    m = re.search(r"frames (\d+)  segments (\d+) \((\d+) duplicates removed\)  map (\d+) segments, "
+                  r"(\d+) bytes", runs["map_out"])
+    assert m, runs["map_out"]
+    frames, segments, duplicates, map_segments, map_bytes = [int(g) for g in m.groups()]
+    built = runs["built"]
+    assert built.stats.frames == frames == FRAMES
+    assert (built.segments, built.duplicates_removed, len(built.map)) == (
+        segments, duplicates, map_segments)
+    ours = os.path.join(runs["work"], "python.map")
+    assert ssm.save_map(ours, built.map) == map_bytes
+    theirs = ssm.load_map(runs["cli_map"])
+    np.testing.assert_allclose(ssm.load_map(ours).centroids, theirs.centroids, atol=1e-5)
+    np.testing.assert_allclose(ssm.load_map(ours).descriptors, theirs.descriptors, atol=1e-3)
+    assert built.trajectory.shape == (FRAMES, 4, 4)
+
+
+def test_localization_equals_the_command_lines(runs):
+    out = runs["localize_out"]
+    m = re.search(r"frames (\d+)  localizations (\d+)  <1 m (\d+)  <5 m (\d+)", out)
+    assert m, out
+    run = runs["run"]
+    s = run.summary()
+    assert [run.stats.frames, s.localizations, s.below_1m, s.below_5m] == [
+        int(g) for g in m.groups()]
+    assert s.localizations > QUERY_FRAMES // 2
+    with open(runs["csv"]) as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["frame"]) for r in rows] == [l.frame_index for l in run.localizations]
+    assert [int(r["inliers"]) for r in rows] == [l.inliers for l in run.localizations]
+    for r, l in zip(rows, run.localizations):
+        np.testing.assert_allclose([float(r[k]) for k in "xyz"], l.T_map_base[:3, 3], atol=2e-4)
+    first = run.localizations[0]
+    assert first.T_map_base.shape == (4, 4) and first.T_world_base.shape == (4, 4)
+    assert first.matches.shape == (first.inliers, 2, 3) and first.matches.dtype == np.float32
+    assert run.trajectory_gt.shape == (QUERY_FRAMES, 4, 4) and run.distance_m > 0
+
+
+def test_a_revisit_range_localized_frame_by_frame(config, describer, runs):
+    ds = ssm.open_dataset(TINY_S1)
+    session = ssm.LocalizationSession(config, ds.info, runs["built"].map, describer)
+    records = [r for r in (session.process(ds[i]) for i in range(395, 426)) if r is not None]
+    assert len(records) >= 5  # once its local map holds enough segments
+    assert all(395 <= r.frame_index <= 425 for r in records)
+    assert max(r.translation_error_m for r in records) < 5.0  # none wrong
+    assert [r.frame_index for r in session.run.localizations] == [r.frame_index for r in records]
