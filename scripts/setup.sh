@@ -31,13 +31,21 @@ for p in "${packages[@]}"; do
 done
 # Debian's nodejs comes without npm; a Node.js that brings its own (NodeSource's) conflicts with it.
 command -v npm > /dev/null || missing+=(npm)
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=()
+  if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -q
+  "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-sudo_cmd=()
-if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
-export DEBIAN_FRONTEND=noninteractive
-"${sudo_cmd[@]}" apt-get update -q
-"${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+# The viewer's npm packages (three.js, esbuild, playwright-core for its browser test) from the
+# committed lockfile into viewer/node_modules, here and not in the build, which downloads nothing.
+# Again only when the lockfile is newer than the last install.
+viewer="$(dirname "$0")/../viewer"
+stamp="$viewer/node_modules/.package-lock.json"
+if [ ! -f "$stamp" ] || [ "$viewer/package-lock.json" -nt "$stamp" ]; then
+  echo "setup: npm ci in viewer/"
+  (cd "$viewer" && npm ci --no-audit --no-fund --loglevel=error)
+fi

@@ -74,7 +74,8 @@ std::string browserMissing() {
   if (!std::filesystem::exists(SEMSEGMAP_CHROMIUM))
     return "no Chromium at '" SEMSEGMAP_CHROMIUM "' (scripts/setup.sh installs Debian's chromium)";
   if (!std::filesystem::exists(SEMSEGMAP_VIEWER_NODE_MODULES "/playwright-core"))
-    return "playwright-core is not in " SEMSEGMAP_VIEWER_NODE_MODULES " (npm ci of the build)";
+    return "playwright-core is not in " SEMSEGMAP_VIEWER_NODE_MODULES
+           " (scripts/setup.sh runs npm ci in viewer/)";
   TempDir tmp;
   const Result v =
       shell("'" SEMSEGMAP_NODE
