@@ -105,16 +105,22 @@ void expectPng(const std::filesystem::path& path) {
   EXPECT_EQ(readFileBytes(path).substr(1, 3), "PNG") << path;
 }
 
-// S1 of the tiny world drives the street of its first 60 frames again from frame 395 on.
+// S1 of the tiny world drives the street of its first 60 frames again from frame 395 on: the map
+// from those 60, SemSegMap's configuration.
+RevisitExperimentConfig tinyRevisit(const std::string& query_frames) {
+  RevisitExperimentConfig cfg;
+  cfg.map_frames = parseFrameRanges("0:59", "map");
+  cfg.query_frames = parseFrameRanges(query_frames, "query");
+  cfg.configs = {loadNamedConfig(kSource + "/config/semsegmap.yaml")};
+  return cfg;
+}
+
 TEST(RevisitExperiment, LocalizesTheRevisitsOfASimulatedRun) {
   SEMSEGMAP_SKIP_WITHOUT_SIM();
   SEMSEGMAP_SKIP_WITHOUT_TORCH();
   TempDir tmp;
   auto source = openDataset("sim:world=1,run=S1,preset=tiny");
-  RevisitExperimentConfig cfg;
-  cfg.map_frames = parseFrameRanges("0:59", "map");
-  cfg.query_frames = parseFrameRanges("395:460", "query");
-  cfg.configs = {loadNamedConfig(kSource + "/config/semsegmap.yaml")};
+  RevisitExperimentConfig cfg = tinyRevisit("395:460");
   cfg.check_ground_truth = true;
   const RevisitExperiment e = evaluateRevisits(*source, cfg, tmp.path());
   writeRevisitFiles(e, tmp.path());
@@ -149,11 +155,8 @@ TEST(RevisitExperiment, WakesUpWithAnEmptyLocalMapAndLocalizesWithinAFewFrames) 
   SEMSEGMAP_SKIP_WITHOUT_TORCH();
   TempDir tmp;
   auto source = openDataset("sim:world=1,run=S1,preset=tiny");
-  RevisitExperimentConfig cfg;
-  cfg.map_frames = parseFrameRanges("0:59", "map");
-  cfg.query_frames = parseFrameRanges("400:449", "query");
+  RevisitExperimentConfig cfg = tinyRevisit("400:449");
   parseWakeUp("5/15", "wake-up", cfg);
-  cfg.configs = {loadNamedConfig(kSource + "/config/semsegmap.yaml")};
   const RevisitExperiment e = evaluateRevisits(*source, cfg, tmp.path());
   EXPECT_EQ(e.queries.size(), 20u);  // 400:404, 415:419, 430:434, 445:449
   const RevisitResult& r = e.results.at(0);

@@ -197,17 +197,26 @@ void noteQuery(RevisitExperiment& e, size_t dataset_frame, const Frame& frame,
           std::min(q.nearest_mapped_m, (frame.T_world_base->translation() - p).norm());
   q.revisit = q.nearest_mapped_m <= e.config.place_radius_m;
   e.revisits += q.revisit;
-  if (check) {  // every query frame: one farther than place_radius_m may still overlap the map
+  // Every query frame: one farther than place_radius_m may still overlap the map.
+  if (check && frame.T_world_base) {
     if (const auto T = check->registered(frame.points, *frame.T_world_base * T_base_lidar)) {
       q.T_world_base_registered = *T * T_base_lidar.inverse();
       q.ground_truth_correction_m =
           (q.T_world_base_registered->translation() - frame.T_world_base->translation()).norm();
-      e.mean_correction_m += q.ground_truth_correction_m;
-      e.max_correction_m = std::max(e.max_correction_m, q.ground_truth_correction_m);
-      ++e.registered;
     }
   }
   e.queries.push_back(q);
+}
+
+// How far registration moved the ground truth, over the query frames where it worked.
+void summarizeCorrections(RevisitExperiment& e) {
+  for (const RevisitFrame& q : e.queries) {
+    if (!q.T_world_base_registered) continue;
+    ++e.registered;
+    e.mean_correction_m += q.ground_truth_correction_m;
+    e.max_correction_m = std::max(e.max_correction_m, q.ground_truth_correction_m);
+  }
+  if (e.registered > 0) e.mean_correction_m /= static_cast<double>(e.registered);
 }
 
 void appendRun(LocalizationRun& all, LocalizationRun run) {
@@ -250,7 +259,7 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
       appendRun(runs[c], std::move(run));
     }
   }
-  if (e.registered > 0) e.mean_correction_m /= static_cast<double>(e.registered);
+  summarizeCorrections(e);
   for (size_t c = 0; c < cfg.configs.size(); ++c) {
     e.results.push_back(resultOf(e, cfg.configs[c], runs[c], maps[c]));
     writeRunFiles(cfg.configs[c], runs[c], maps[c], e, out);
