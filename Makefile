@@ -10,7 +10,7 @@ else
 CMAKE_FLAGS := -DCMAKE_BUILD_TYPE=Release
 endif
 
-.PHONY: setup build test demo bench format clean
+.PHONY: setup build test demo bench fuzz format clean
 
 setup:
 	bash scripts/setup.sh
@@ -28,8 +28,27 @@ demo: build
 bench: build
 	./$(BUILD)/bench/semsegmap_bench
 
+# The libFuzzer harnesses of the parsers (fuzz/): built by clang with ASan and UBSan into
+# build-fuzz/, then each run for FUZZ_SECONDS from seeds the build generates. Skipped, saying
+# why, when clang or its fuzzer runtime is missing.
+FUZZ_SECONDS ?= 4
+FUZZ_CMAKE_FLAGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  -DSEMSEGMAP_FUZZ=ON -DSEMSEGMAP_WITH_SIM=OFF -DSEMSEGMAP_WITH_PYTHON=OFF \
+  -DSEMSEGMAP_WITH_VIEWER=OFF -DSEMSEGMAP_BUILD_TESTS=OFF -DSEMSEGMAP_BUILD_BENCH=OFF
+fuzz: setup
+	@if ! command -v clang++ > /dev/null; then \
+	  echo "fuzz: skipped: clang++ is missing (scripts/setup.sh installs clang)"; \
+	elif ! printf 'extern "C" int LLVMFuzzerTestOneInput(const char*, unsigned long) { return 0; }' \
+	    | clang++ -x c++ -fsanitize=fuzzer - -o /dev/null 2> /dev/null; then \
+	  echo "fuzz: skipped: clang cannot link -fsanitize=fuzzer (scripts/setup.sh installs libclang-rt-14-dev)"; \
+	else \
+	  cmake -S . -B build-fuzz $(FUZZ_CMAKE_FLAGS) && \
+	  cmake --build build-fuzz -j $(JOBS) --target semsegmap_fuzzers && \
+	  bash fuzz/run.sh build-fuzz $(FUZZ_SECONDS); \
+	fi
+
 format:
-	find cpp apps tests bench python/src -name '*.cpp' -o -name '*.h' | xargs clang-format -i
+	find cpp apps tests bench fuzz python/src -name '*.cpp' -o -name '*.h' | xargs clang-format -i
 
 clean:
-	rm -rf build build-asan build-min
+	rm -rf build build-asan build-min build-fuzz

@@ -18,6 +18,9 @@ packages=(
   python3-onnx python3-numpy
   # the Python module (python/, SEMSEGMAP_WITH_PYTHON) and its pytest suite, for Debian's python3
   pybind11-dev python3-dev python3-pytest
+  # make fuzz: the parsers' libFuzzer harnesses are built by clang with its fuzzer and sanitizer
+  # runtimes (fuzz/, cmake/SemsegmapFuzz.cmake)
+  clang libclang-rt-14-dev
   # make bench only: the odometry benchmark compares Open3D's registration (optional in CMake)
   libopen3d-dev
   # semsegmap view: its page is bundled with Node.js at build time (viewer/, npm ci), and its

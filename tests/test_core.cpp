@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <set>
 #include <stdexcept>
 
@@ -140,6 +141,42 @@ TEST(SensorRig, ValidateNamesTheBadField) {
   rig = defaultSimRig();
   rig.cameras[0].T_camera_lidar.linear() *= 2.0;
   EXPECT_THROW(rig.validate(), std::invalid_argument);
+}
+
+// issue 18: a 40000 x 40000 camera read from a file passed (only > 0 was checked) and made the
+// enricher allocate 6+ GB inside an OpenMP loop, which aborts. Sizes, counts and poses have
+// limits, each named.
+TEST(SensorRig, ValidateRefusesHugeSizesAndNonFinitePoses) {
+  const auto messageOf = [](const SensorRig& rig) {
+    try {
+      rig.validate();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  SensorRig rig = defaultSimRig();
+  rig.cameras[1].width = rig.cameras[1].height = 40000;
+  rig.cameras[1].cx = rig.cameras[1].cy = 20000;
+  EXPECT_NE(messageOf(rig).find("width and height must be in 1..16384, got 40000 x 40000"),
+            std::string::npos)
+      << messageOf(rig);
+  rig = defaultSimRig();
+  rig.cameras.resize(kMaxCameras + 1, rig.cameras[0]);
+  EXPECT_NE(messageOf(rig).find("65 cameras, at most 64"), std::string::npos) << messageOf(rig);
+  rig = defaultSimRig();
+  rig.lidar.columns = 1 << 30;
+  EXPECT_NE(messageOf(rig).find("lidar.columns"), std::string::npos) << messageOf(rig);
+  rig = defaultSimRig();
+  rig.T_base_lidar.translation().x() = std::numeric_limits<double>::infinity();
+  EXPECT_NE(messageOf(rig).find("T_base_lidar"), std::string::npos) << messageOf(rig);
+  rig = defaultSimRig();
+  rig.cameras[0].T_camera_lidar.translation().y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(messageOf(rig).find("T_camera_lidar has a NaN"), std::string::npos) << messageOf(rig);
+  rig = defaultSimRig();
+  rig.rate_hz = std::numeric_limits<double>::infinity();
+  EXPECT_NE(messageOf(rig).find("rate_hz"), std::string::npos) << messageOf(rig);
+  EXPECT_EQ(messageOf(defaultSimRig()), "(no error)");
 }
 
 // ---- The binary reader and writer of every file format ------------------------------------------

@@ -4,7 +4,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +20,7 @@
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/image_io.h"
+#include "semsegmap/io/run_output.h"
 #include "temp_dir.h"
 
 namespace semsegmap {
@@ -373,6 +376,16 @@ TEST_F(MetaYamlErrors, BadPose) {
                  "lidar.T_base_lidar: expected [x, y, z, qx, qy, qz, qw]");
 }
 
+// 1e308 is finite, and used to give 0 segments and exit 0: a sensor 100 m from the base is no rig.
+TEST_F(MetaYamlErrors, AbsurdExtrinsic) {
+  const size_t from = text_.find("T_base_lidar: [");
+  ASSERT_NE(from, std::string::npos);
+  const size_t to = text_.find(']', from);
+  std::string mutated = text_;
+  mutated.replace(from, to + 1 - from, "T_base_lidar: [1e308, 0, 0, 0, 0, 0, 1]");
+  expectRejected(mutated, "lidar.T_base_lidar: translation [1e+308, 0, 0] m: more than 100 m");
+}
+
 TEST_F(MetaYamlErrors, DuplicateClassId) {
   expectRejected(replaceOnce(text_, "{id: 14,", "{id: 13,"), "id 13 appears twice");
 }
@@ -400,23 +413,34 @@ class DamagedFrames : public ::testing::Test {
     EXPECT_NO_THROW(reader.frame(0));
     EXPECT_NO_THROW(reader.frame(2));
   }
+  // A missing or mis-sized file is found by stat when the reader opens, before any frame is
+  // read; a run of frame 0 alone does not look at frame 1's files.
+  void expectFoundBeforeAnyFrame(const std::vector<std::string>& parts) {
+    expectError([&] { DatasetReader reader(tmp_.path()); }, parts);
+    expectError([&] { DatasetReader reader(tmp_.path(), 2); }, parts);
+    DatasetReader first(tmp_.path(), 1);
+    EXPECT_EQ(first.size(), 3u);
+    EXPECT_NO_THROW(first.frame(0));
+    EXPECT_NO_THROW(first.frame(2));
+    expectError([&] { first.frame(1); }, {parts.front()});
+  }
   TempDir tmp_;
 };
 
 TEST_F(DamagedFrames, TruncatedLidarBin) {
   fs::resize_file(file("lidar/000001.bin"), 11 * 16 - 3);
-  expectFrame1Fails(
+  expectFoundBeforeAnyFrame(
       {file("lidar/000001.bin").string(), "truncated (173 bytes is not a multiple of 16)"});
 }
 
 TEST_F(DamagedFrames, MissingLidarBin) {
   fs::remove(file("lidar/000001.bin"));
-  expectFrame1Fails({file("lidar/000001.bin").string(), ": missing"});
+  expectFoundBeforeAnyFrame({file("lidar/000001.bin").string(), ": missing"});
 }
 
 TEST_F(DamagedFrames, MissingCameraPng) {
   fs::remove(file("cam1/000001.png"));
-  expectFrame1Fails({file("cam1/000001.png").string(), ": missing"});
+  expectFoundBeforeAnyFrame({file("cam1/000001.png").string(), ": missing"});
 }
 
 TEST_F(DamagedFrames, PngOfTheWrongSize) {
@@ -429,10 +453,16 @@ TEST_F(DamagedFrames, RgbWhereALabelImageBelongs) {
   expectFrame1Fails({file("cam0_label/000001.png").string(), "3 channels, expected 1"});
 }
 
+TEST_F(DamagedFrames, MissingLabelImage) {
+  fs::remove(file("cam0_label/000001.png"));
+  expectFoundBeforeAnyFrame({file("cam0_label/000001.png").string(), ": missing"});
+}
+
 TEST_F(DamagedFrames, LabelCountDiffersFromPointCount) {
   writeLabelBin(file("lidar_gt/000001.bin"), std::vector<PointLabel>(7));
-  expectFrame1Fails({file("lidar_gt/000001.bin").string(), file("lidar/000001.bin").string(),
-                     "7 labels", "11 points"});
+  expectFoundBeforeAnyFrame({file("lidar_gt/000001.bin").string(),
+                             file("lidar/000001.bin").string(), "28 bytes, expected 44",
+                             "11 points"});
 }
 
 TEST_F(DamagedFrames, LabelWithAClassNotInTheTable) {
@@ -452,6 +482,8 @@ TEST_F(DamagedFrames, NanInALidarFile) {
 
 TEST_F(DamagedFrames, GarbagePng) {
   writeText(file("cam1_label/000001.png"), "this is not a PNG at all");
+  expectFoundBeforeAnyFrame({file("cam1_label/000001.png").string(), "too small for a PNG"});
+  writeText(file("cam1_label/000001.png"), std::string(100, 'x'));  // a plausible size
   expectFrame1Fails({file("cam1_label/000001.png").string(), "not a PNG"});
 }
 
@@ -481,6 +513,122 @@ TEST(DatasetIo, BadFramesCsvRowNamesFileAndLine) {
 
   writeText(csv, replaceOnce(good, "index,", "idx,"));
   expectError([&] { DatasetReader reader(tmp.path()); }, {csv.string(), "line 1"});
+}
+
+TEST(DatasetIo, AbsurdPositionInFramesCsvIsRefused) {
+  TempDir tmp;
+  writeTinyDataset(tmp.path());
+  const fs::path csv = tmp.path() / "frames.csv";
+  const std::string good = readText(csv);
+  const size_t row = good.find("\n1,");
+  const size_t odom_x = good.find(',', good.find(',', row + 1) + 1) + 1;
+  std::string bad = good;
+  bad.replace(odom_x, good.find(',', odom_x) - odom_x, "1e308");
+  writeText(csv, bad);
+  expectError([&] { DatasetReader reader(tmp.path()); },
+              {csv.string(), "line 3: odom_x: 1e308 m is beyond 10000000 m"});
+}
+
+size_t residentKib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::stoul(line.substr(6));
+  return 0;
+}
+
+// frames.csv is streamed: a million rows (the old reader held about 0.5 KB a row, 500 MB here)
+// leave the reader's memory flat, a run of the first frame checks only its files, and any row
+// reads back by seeking, in any order.
+TEST(DatasetIo, AMillionRowFramesCsvIsIndexedNotHeld) {
+  TempDir tmp;
+  writeTinyDataset(tmp.path());
+  const fs::path csv = tmp.path() / "frames.csv";
+  constexpr size_t kRows = 1000000;
+  {
+    std::ofstream out(csv, std::ios::app | std::ios::binary);
+    char line[160];
+    for (size_t i = 4; i < kRows + 1; ++i) {
+      std::snprintf(line, sizeof line, "%zu,%zu.5,%zu,2,3,0,0,0,1,,,,,,,\n", i, i, i % 1000);
+      out << line;
+    }
+  }
+  const size_t before = residentKib();
+  DatasetReader reader(tmp.path(), 1);
+  const size_t after = residentKib();
+  ASSERT_EQ(reader.size(), kRows);
+  EXPECT_LT(after - std::min(after, before), 20u * 1024u) << "KiB grown while indexing";
+  EXPECT_NO_THROW(reader.frame(0));
+  EXPECT_DOUBLE_EQ(reader.frameTime(kRows - 1), 1000000.5);
+  EXPECT_DOUBLE_EQ(reader.frameTime(5000), 5001.5);  // back, then forward again
+  EXPECT_DOUBLE_EQ(reader.frameTime(5001), 5002.5);
+  EXPECT_DOUBLE_EQ(reader.frameTime(2), reader.frame(2).timestamp_s);
+  // Checking every row's files finds the first frame without any.
+  expectError([&] { DatasetReader all(tmp.path()); },
+              {(tmp.path() / "lidar" / "000004.bin").string(), "missing"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// RunOutputs: a failed command's outputs are removed, nothing that was there before
+
+std::vector<std::string> entriesOf(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    names.push_back(e.path().lexically_relative(dir).string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(RunOutputs, AFailedRunRemovesWhatItCreatedAndNothingElse) {
+  TempDir tmp;
+  const fs::path old_dir = tmp.path() / "old";
+  fs::create_directories(old_dir / "kept_empty");
+  writeText(old_dir / "mine.txt", "before");
+  writeText(old_dir / "replaced.txt", "before");
+  {
+    RunOutputs outputs;
+    outputs.folder(old_dir);
+    outputs.folder(tmp.path() / "new" / "deep");
+    outputs.file(tmp.path() / "files" / "x.map");
+    EXPECT_TRUE(fs::is_directory(tmp.path() / "new" / "deep"));  // made up front
+    fs::create_directories(old_dir / "sub");
+    writeBytesAtomically(old_dir / "sub" / "summary.json", "{}");
+    writeBytesAtomically(old_dir / "replaced.txt", "after");
+    writeBytesAtomically(tmp.path() / "new" / "deep" / "a.csv", "a");
+    writeBytesAtomically(tmp.path() / "files" / "x.map", "m");
+    writeBytesAtomically(tmp.path() / "cache.bin", "outside the outputs: kept");
+  }  // not committed: the command failed
+  EXPECT_EQ(entriesOf(tmp.path()), (std::vector<std::string>{"cache.bin", "old", "old/kept_empty",
+                                                             "old/mine.txt", "old/replaced.txt"}));
+  EXPECT_EQ(readText(old_dir / "mine.txt"), "before");
+}
+
+TEST(RunOutputs, ACommittedRunKeepsEverything) {
+  TempDir tmp;
+  {
+    RunOutputs outputs;
+    outputs.folder(tmp.path() / "out");
+    writeBytesAtomically(tmp.path() / "out" / "summary.json", "{}");
+    outputs.commit();
+  }
+  EXPECT_TRUE(fs::exists(tmp.path() / "out" / "summary.json"));
+}
+
+TEST(RunOutputs, OutputsOfTheWrongKindAreRefusedBeforeAnythingIsMade) {
+  TempDir tmp;
+  writeText(tmp.path() / "file", "x");
+  fs::create_directories(tmp.path() / "dir");
+  RunOutputs outputs;
+  expectError([&] { outputs.file(tmp.path() / "dir", "--out"); },
+              {(tmp.path() / "dir").string(), "--out is a directory, expected a file"});
+  expectError([&] { outputs.folder(tmp.path() / "file"); }, {"exists and is not a directory"});
+  expectError([&] { outputs.folder(tmp.path() / "file" / "a" / "b"); },
+              {"cannot be created", (tmp.path() / "file").string() + " is not a directory"});
+  EXPECT_EQ(entriesOf(tmp.path()), (std::vector<std::string>{"dir", "file"}));
+  if (::geteuid() == 0) return;  // root writes anywhere: no read-only case to check
+  fs::permissions(tmp.path() / "dir", fs::perms::owner_read | fs::perms::owner_exec);
+  expectError([&] { outputs.folder(tmp.path() / "dir" / "out"); }, {"cannot be written"});
+  fs::permissions(tmp.path() / "dir", fs::perms::owner_all);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -208,6 +208,28 @@ TEST(Enrich, PointTakesExactlyThePixelItProjectsInto) {
   EXPECT_EQ(cloud[2].class_id, *f.cameras[0].label.at(39, 0));
 }
 
+// issue 18: a camera of 40000 x 40000 pixels made the z-buffers (12 GB) be allocated inside an
+// OpenMP loop, where a failed allocation aborts the process. The size is refused first, and the
+// buffers are allocated before the loop, where an allocation error is an exception.
+TEST(Enrich, HugeCameraIsRefusedBeforeItsZBufferIsAllocated) {
+  SensorRig rig;
+  rig.cameras = {makeCamera("huge")};
+  rig.cameras[0].width = rig.cameras[0].height = 40000;
+  Frame f;
+  f.cameras.resize(1);  // no images: the camera's z-buffer is still made
+  f.points = {LidarPoint{5, 0, 0, 1}};
+  try {
+    enrichFrame(f, rig, EnrichmentConfig{});
+    ADD_FAILURE() << "a 40000 x 40000 camera was enriched";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 'huge': size 40000x40000 is outside 1..16384"),
+              std::string::npos)
+        << e.what();
+  }
+  rig.cameras[0].width = rig.cameras[0].height = 2048;  // a large real camera still works
+  EXPECT_EQ(enrichFrame(f, rig, EnrichmentConfig{}).size(), 1u);
+}
+
 TEST(Enrich, PointsBehindOrOutsideGetUnknownAndNoColour) {
   SensorRig rig;
   rig.cameras = {makeCamera("cam")};

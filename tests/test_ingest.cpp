@@ -6,17 +6,20 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
 #include "error_text.h"
+#include "fuzz_regressions.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/sensor_rig.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/enrich/enricher.h"
 #include "semsegmap/io/dataset_format.h"
+#include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/folder_reader.h"
 #include "semsegmap/io/image_io.h"
@@ -272,6 +275,33 @@ TEST(PointFields, DecodesPaddedFloat64LayoutsWithTimes) {
       << outside_error;
 }
 
+// A ring beyond any LiDAR's rows (or one no int holds) and a non-finite time are corrupt records,
+// refused naming the point; a NaN coordinate is an organized cloud's "no return", dropped.
+TEST(PointFields, CorruptRingsAndTimesAreRefusedNaNPointsDropped) {
+  const std::vector<PointFieldSpec> fields = {{"x", 0, FieldType::kFloat32, 1},
+                                              {"y", 4, FieldType::kFloat32, 1},
+                                              {"z", 8, FieldType::kFloat32, 1},
+                                              {"ring", 12, FieldType::kFloat32, 1},
+                                              {"t", 16, FieldType::kFloat32, 1}};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> records = {1, 2, 3, 5, 0.01f, nan, 2, 3, 1, 0.02f};
+  const auto decode = [&] {
+    return decodePointFields(fields, 20, reinterpret_cast<const uint8_t*>(records.data()),
+                             records.size() * 4, 2, "cloud");
+  };
+  const DecodedPoints d = decode();
+  EXPECT_EQ(d.points.size(), 1u);
+  EXPECT_EQ(d.dropped_invalid, 1u);
+  EXPECT_EQ(d.rings, 6);
+  records[3] = 1e30f;
+  EXPECT_NE(errorOf(decode).find("cloud: point 0 has the ring"), std::string::npos)
+      << errorOf(decode);
+  records[3] = 5;
+  records[4] = std::numeric_limits<float>::infinity();
+  EXPECT_NE(errorOf(decode).find("cloud: point 0 has the time inf (field 't')"), std::string::npos)
+      << errorOf(decode);
+}
+
 TEST(PointFields, AbsoluteTimesBecomeRelative) {
   const std::vector<float> rel = relativePointTimes({1650000000.05, 1650000000.08}, 1650000000.0);
   EXPECT_NEAR(rel[0], 0.05, 1e-6);
@@ -309,6 +339,35 @@ TEST(PointCloudFile, ReadsPcdInEveryEncodingAndRefusesTruncation) {
   EXPECT_NE(wrong.find("w.pcd"), std::string::npos) << wrong;
   EXPECT_NE(errorOf([&] { readPointCloudFile(tmp.path() / "none.pcd"); }).find("no such file"),
             std::string::npos);
+}
+
+// Headers that promise more points than their file holds are refused before PCL allocates them
+// (an ASCII header of 4 * 10^9 points was 48 GB allocated).
+TEST(PointCloudFile, OversizedHeadersAreRefusedBeforeReading) {
+  TempDir tmp;
+  const std::string head =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nVIEWPOINT 0 0 0 1 0 0 0\n";
+  for (const char* data : {"ascii", "binary", "binary_compressed"}) {
+    writeText(tmp.path() / "huge.pcd", head +
+                                           "WIDTH 4000000000\nHEIGHT 1\n"
+                                           "POINTS 4000000000\nDATA " +
+                                           data + "\n1 2 3\n");
+    const std::string error = errorOf([&] { readPointCloudFile(tmp.path() / "huge.pcd"); });
+    EXPECT_NE(error.find("huge.pcd: truncated or corrupt: the header promises 4000000000 points"),
+              std::string::npos)
+        << data << ": " << error;
+  }
+  writeText(tmp.path() / "few.pcd",
+            head + "WIDTH 1000\nHEIGHT 1\nPOINTS 1000\nDATA ascii\n1 2 3\n");
+  EXPECT_NE(errorOf([&] { readPointCloudFile(tmp.path() / "few.pcd"); }).find("few.pcd: "),
+            std::string::npos);
+  writeText(tmp.path() / "huge.ply",
+            "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n");
+  const std::string ply = errorOf([&] { readPointCloudFile(tmp.path() / "huge.ply"); });
+  EXPECT_NE(ply.find("huge.ply: truncated or corrupt: the header promises 4000000000 vertices"),
+            std::string::npos)
+      << ply;
 }
 
 TEST(PointCloudFile, ReadsPlyInBothEncodings) {
@@ -549,3 +608,30 @@ TEST(ConvertFolder, SameFramesAsReadingDirectly) {
   }
 }
 #endif
+
+// ------------------------------------------------------------------------------------------
+// What the fuzz harnesses found (tests/fuzz_regressions/), through the harnesses' own calls.
+
+TEST(FuzzRegressions, PointCloudFiles) {
+  TempDir tmp;
+  for (const auto& [name, bytes] : semsegmap::test_support::fuzzRegressions("point_cloud_file")) {
+    const fs::path path = tmp.path() / (bytes.rfind("ply", 0) == 0 ? "scan.ply" : "scan.pcd");
+    std::ofstream(path, std::ios::binary) << bytes;
+    semsegmap::test_support::expectCleanRefusal(name, path.string(),
+                                                [&] { readPointCloudFile(path); });
+  }
+}
+
+// The harness's input is meta.yaml, a line "--- frames.csv ---", then frames.csv.
+TEST(FuzzRegressions, DatasetFolders) {
+  TempDir tmp;
+  for (const auto& [name, bytes] : semsegmap::test_support::fuzzRegressions("dataset_dir")) {
+    const std::string separator = "\n--- frames.csv ---\n";
+    const size_t at = bytes.find(separator);
+    std::ofstream(tmp.path() / "meta.yaml", std::ios::binary) << bytes.substr(0, at);
+    std::ofstream(tmp.path() / "frames.csv", std::ios::binary)
+        << (at == std::string::npos ? "" : bytes.substr(at + separator.size()));
+    semsegmap::test_support::expectCleanRefusal(name, tmp.path().string(),
+                                                [&] { DatasetReader reader(tmp.path()); });
+  }
+}

@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -343,6 +346,25 @@ TEST(TrainingData, CacheRoundTripsAndKnowsWhatItWasMadeFrom) {
     f.put('\x5a');
   }
   EXPECT_THROW(readTrainingCache(path, "made from A"), std::runtime_error);
+  std::filesystem::remove(path);
+}
+
+// A cache whose checksum is right but whose values are not finite (written so by a bug) is
+// refused, naming the segment, rather than training on NaN.
+TEST(TrainingData, CacheWithANonFiniteValueIsRefused) {
+  TrainingSet set = syntheticSet(3, 1);
+  set.observations[1].xyzhsv[4] = std::numeric_limits<float>::infinity();
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("test_learn_cache_nan_" + std::to_string(::getpid()) + ".bin");
+  writeTrainingCache(path, set, "made from A");
+  try {
+    readTrainingCache(path, "made from A");
+    ADD_FAILURE() << "a cache holding inf was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path.string() + ": corrupt training cache (a non-finite value in the observation " +
+                  "of segment " + std::to_string(set.observations[1].segment) + ")");
+  }
   std::filesystem::remove(path);
 }
 

@@ -2,8 +2,10 @@
 // flow, model files, inference invariances, and that a small network can learn at all.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
 #include <unistd.h>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,7 @@
 #include <set>
 #include <string>
 
+#include "semsegmap/core/binary_io.h"
 #include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/describe/learned_net.h"
 #include "semsegmap/describe/net_input.h"
@@ -455,6 +458,112 @@ TEST(ModelFile, ModalitiesAreRecordedFingerprintedAndApplied) {
   EXPECT_NEAR(without.class_grid[0][cls::kUnknown].sum().item<float>(),
               with.class_grid[0][cls::kCar].sum().item<float>(), 1e-4);
   EXPECT_TRUE(torch::equal(with.points.narrow(2, 0, 3), without.points.narrow(2, 0, 3)));
+  std::filesystem::remove_all(dir);
+}
+
+// The shapes a configuration implies, without torch (net_config.h), are those of the networks.
+TEST(ModelFile, TensorShapesOfAConfigurationAreThoseOfItsNetwork) {
+  std::vector<NetConfig> configs;
+  for (const DescriptorKind kind : {DescriptorKind::kSemSegMapNet, DescriptorKind::kSegMapCnn}) {
+    configs.push_back(tinyConfig(kind));
+    NetConfig other = tinyConfig(kind);
+    other.recon_grid = 32;
+    other.pointnet_width = 3;
+    other.cnn_width = 5;
+    other.grid_xy = 16;
+    other.num_classes = 7;
+    configs.push_back(other);
+  }
+  configs.push_back(NetConfig{});
+  for (const NetConfig& config : configs) {
+    const Model model = modelOf(*makeNet(config));
+    const std::vector<TensorShape> shapes = netTensorShapes(config);
+    ASSERT_EQ(shapes.size(), model.tensors.size()) << descriptorName(config.kind);
+    for (size_t i = 0; i < shapes.size(); ++i) {
+      EXPECT_EQ(shapes[i].name, model.tensors[i].name);
+      EXPECT_EQ(shapes[i].shape, model.tensors[i].shape) << shapes[i].name;
+      EXPECT_EQ(shapes[i].numel(), model.tensors[i].values.size()) << shapes[i].name;
+    }
+  }
+}
+
+namespace {
+
+// A model file's header (io/model_file.h, version 3) for `config`, then `tensor_count`, and no
+// tensors: what a corrupt or truncated file starts with.
+std::string modelHeader(const NetConfig& c, uint64_t tensor_count) {
+  BinaryWriter w;
+  w.putBytes("SSMNET", 6);
+  w.put<uint32_t>(3);
+  w.putString32(descriptorName(c.kind));
+  for (const int32_t f :
+       {c.descriptor_dim, c.num_points, c.num_classes, c.grid_xy, c.grid_z, c.recon_grid,
+        c.pointnet_width, c.cnn_width, c.sa1_divisor, c.sa2_divisor, c.sa_neighbours})
+    w.put(f);
+  w.put(c.sa1_radius);
+  w.put(c.sa2_radius);
+  w.put<uint8_t>(1);
+  w.put<uint8_t>(1);
+  w.putBytes("0123456789abcdef", 16);
+  w.put(tensor_count);
+  return w.take();
+}
+
+long peakRssKb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss;
+}
+
+}  // namespace
+
+// issue 18: a 72-byte model file built the whole network of its header (3.3 GB, 24 s) before
+// the file was known to be too short. Now the header's ranges, the tensor count and every tensor's
+// name and shape are checked against the file before a tensor is allocated or a network built.
+TEST(ModelFile, OversizedOrShortHeadersAreRefusedBeforeAnythingIsBuilt) {
+  const auto dir = tempDir();
+  const auto path = dir / "hostile.ssmnet";
+  NetConfig largest;  // every width at its limit: ~10^8 parameters, were it built
+  largest.descriptor_dim = 1024;
+  largest.num_points = 16384;
+  largest.pointnet_width = 256;
+  largest.recon_grid = 64;
+  const long rss_before = peakRssKb();
+  const auto start = std::chrono::steady_clock::now();
+  const size_t expected_tensors = netTensorShapes(largest).size();
+  writeBytes(path, modelHeader(largest, 0));
+  expectFileError([&] { loadNet(path); }, path, "0 tensors in the file");
+  writeBytes(path, modelHeader(largest, expected_tensors));
+  expectFileError([&] { loadNet(path); }, path, "does not fit in the rest of the file");
+  // The tensors' count fits, but the first tensor's shape is not the configuration's.
+  BinaryWriter tensor;
+  tensor.putString32("sa1.0.weight");
+  tensor.put<uint32_t>(4);
+  for (const int64_t s : {int64_t{1} << 30, int64_t{6}, int64_t{1}, int64_t{1}}) tensor.put(s);
+  writeBytes(path,
+             modelHeader(largest, expected_tensors) + tensor.bytes() + std::string(1024, '\0'));
+  expectFileError([&] { loadNet(path); }, path, "[256, 6, 1, 1] expected");
+  // The config's values are limited before any shape is computed from them.
+  NetConfig too_wide = largest;
+  too_wide.pointnet_width = 1 << 20;
+  writeBytes(path, modelHeader(too_wide, 40));
+  expectFileError([&] { loadNet(path); }, path, "corrupt header: NetConfig.pointnet_width");
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 2.0);
+  EXPECT_LT(peakRssKb() - rss_before, 100 * 1024) << "KB more at the peak";
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ModelFile, NonFiniteWeightsAreRefused) {
+  const auto dir = tempDir();
+  const NetConfig config = tinyConfig(DescriptorKind::kSegMapCnn);
+  Model model = modelOf(*makeNet(config));
+  model.tensors[3].values[2] = std::numeric_limits<float>::quiet_NaN();
+  const auto path = dir / "nan.ssmnet";
+  writeModelFile(path, model);
+  expectFileError([&] { readModelFile(path); }, path,
+                  "corrupt weights: tensor " + model.tensors[3].name);
   std::filesystem::remove_all(dir);
 }
 

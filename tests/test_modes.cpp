@@ -93,6 +93,16 @@ TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {
     EXPECT_NE(json.find(std::string("\"") + key + "\""), std::string::npos) << key;
 }
 
+// A run that localized nothing has no mean error: null, never a 0 that reads as perfect.
+TEST(Modes, SummaryOfARunWithoutLocalizationsHasNoMeanError) {
+  LocalizationRun run;
+  run.trajectory_gt.assign(3, Pose::Identity());
+  run.stats.frames = 3;
+  const std::string json = localizationSummaryJson(run, SummaryContext{});
+  EXPECT_NE(json.find("\"mean_translation_error_m\": null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"mean_rotation_error_deg\": null"), std::string::npos) << json;
+}
+
 TEST(Modes, LocalizationRefusesAMapOfAnotherModel) {
   SEMSEGMAP_SKIP_WITHOUT_SIM();
   const auto oracle = std::make_shared<OracleDescriber>();

@@ -7,6 +7,7 @@
 #include <sqlite3.h>
 #include <zstd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -27,6 +28,7 @@
 #endif
 
 #include "error_text.h"
+#include "fuzz_regressions.h"
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/kitti_raw_reader.h"
@@ -35,6 +37,7 @@
 #include "semsegmap/io/ros_serialization.h"
 #include "semsegmap/io/ros_tf.h"
 #include "semsegmap/io/rosbag_reader.h"
+#include "semsegmap/io/rosbag_storage.h"
 #include "temp_dir.h"
 
 namespace {
@@ -1347,4 +1350,69 @@ TEST(Mcap, CorruptFilesNameTheFile) {
   std::ofstream(damaged, std::ios::binary) << bytes;
   EXPECT_MENTIONS(errorOf([&] { RosbagReader r(damaged); }),
                   damaged.string() + ": corrupt MCAP chunk (zstd: ");
+}
+
+// A chunk whose `records` size is near 2^64 wrapped the bound check around (offset + size) and
+// was allocated whole: now it is refused as a chunk whose records end past it.
+TEST(Mcap, ChunkSizesNearTwoToTheSixtyFourAreRefused) {
+  TempDir dir;
+  const Recording rec;
+  const fs::path bag = dir.path() / "wrapped.mcap";
+  writeMcap(bag, rec.messages(), "", 100);
+  std::string bytes;
+  {
+    std::ifstream in(bag, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // The chunk record: opcode, length, two times, uncompressed size and crc, the compression
+  // name (empty: a uint32 0), then the uint64 size of its records.
+  uint64_t header_length = 0;  // the Header record follows the magic; the chunk follows it
+  std::memcpy(&header_length, bytes.data() + 8 + 1, 8);
+  const size_t chunk = 8 + 9 + header_length;
+  ASSERT_EQ(bytes[chunk], '\x06');
+  const size_t records_size = chunk + 9 + 8 + 8 + 8 + 4 + 4;
+  const uint64_t huge = ~uint64_t{0} - 16;
+  std::memcpy(bytes.data() + records_size, &huge, 8);
+  std::ofstream(bag, std::ios::binary) << bytes;
+  const std::string e = errorOf([&] { RosbagReader r(bag); });
+  EXPECT_MENTIONS(e, bag.string() + ": corrupt MCAP chunk at byte " + std::to_string(chunk));
+  EXPECT_ONE_LINE(e);
+}
+
+// What the message harness (fuzz/fuzz_ros_messages.cpp) found: its first byte chooses the type
+// (0: PointCloud2, 1: Image, 2: CompressedImage) and the wire format (high bit: CDR), the rest is
+// the message. A reproducer may be a valid message that hung (a cloud of 4 * 10^9 empty rows): each
+// must be decoded, or refused naming the topic, within a second.
+TEST(FuzzRegressions, RosMessages) {
+  for (const auto& [name, bytes] : semsegmap::test_support::fuzzRegressions("ros_messages")) {
+    ASSERT_FALSE(bytes.empty());
+    rm::SerializedMessage m;
+    m.format = bytes[0] & 0x80 ? rm::WireFormat::kCdr : rm::WireFormat::kRos1;
+    m.bytes = bytes.substr(1);
+    m.file = "fuzz.bag";
+    m.topic = "/fuzz/topic";
+    const int type = (bytes[0] & 0x7f) % 7;
+    ASSERT_LE(type, 2) << name << ": a type this test does not decode";
+    const auto start = std::chrono::steady_clock::now();
+    semsegmap::test_support::expectNoFinding(name, "/fuzz/topic", [&] {
+      if (type == 0) rm::decodePointCloud2(rm::parsePointCloud2(m), m.topic);
+      if (type == 1) rm::decodeImage(rm::parseImage(m), m.topic);
+      if (type == 2) rm::decodeCompressedImage(rm::parseCompressedImage(m), m.topic);
+    });
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0)
+        << name;
+  }
+}
+
+// What the storage harness found: ROS 1 bags whose record lengths rosbag allocated as read.
+TEST(FuzzRegressions, BagStorages) {
+  TempDir dir;
+  for (const auto& [name, bytes] : semsegmap::test_support::fuzzRegressions("rosbag_storage")) {
+    const fs::path bag = dir.path() / (bytes.rfind("#ROSBAG", 0) == 0 ? "input.bag" : "input.mcap");
+    std::ofstream(bag, std::ios::binary) << bytes;
+    semsegmap::test_support::expectCleanRefusal(name, bag.string(), [&] {
+      const auto storage = rm::openBagStorage(bag);
+      for (const rm::BagTopic& topic : storage->topics()) storage->messages(topic.name);
+    });
+  }
 }

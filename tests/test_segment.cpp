@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -244,4 +246,44 @@ TEST(PipelineConfig, UnknownKeysAndBadValuesNameTheFile) {
   expectError("local_map: [1, 2]\n", "local_map");
   std::filesystem::remove(path);
   EXPECT_THROW(loadPipelineConfig("/nonexistent/config.yaml"), std::runtime_error);
+}
+
+// issue 18: a directory given as config said "basic_filebuf::underflow", `localization.k:
+// 1000000000` "std::bad_alloc" and a value of the wrong type yaml-cpp's "bad conversion". Each now
+// names the file, the key and the value, and every count has limits.
+TEST(PipelineConfig, CountsValuesAndDirectoriesNameTheFileAndTheKey) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("semsegmap_test_config_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "config.yaml");  // a directory of that name
+  const auto errorOf = [](const std::filesystem::path& path) {
+    try {
+      loadPipelineConfig(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(errorOf(dir / "config.yaml"),
+            (dir / "config.yaml").string() + ": not a config file (a directory or a device)");
+  const auto path = dir / "file.yaml";
+  const auto expectError = [&](const std::string& yaml, const std::string& what) {
+    std::ofstream(path) << yaml;
+    EXPECT_EQ(errorOf(path), path.string() + ": " + what) << yaml;
+  };
+  expectError("localization:\n  k: 1000000000\n",
+              "localization.k: wrong type: expected an integer in [1, 1000], got '1000000000'");
+  expectError("localization:\n  k: 2.5\n",
+              "localization.k: wrong type: expected an integer in [1, 1000], got '2.5'");
+  expectError("segmentation:\n  d_segment_m: .inf\n",
+              "segmentation.d_segment_m: wrong type: expected a finite number, got '.inf'");
+  expectError("descriptor:\n  batch: [1]\n",
+              "descriptor.batch: wrong type: expected an integer in [1, 4096], got a list");
+  expectError("local_map:\n  remove_unknown_class: maybe\n",
+              "local_map.remove_unknown_class: wrong type: expected true or false, got 'maybe'");
+  expectError("semantics:\n  mean: [0.5, nan, 0.5]\n",
+              "semantics.mean: wrong type: expected a list of finite numbers, got a list");
+  expectError("odometry:\n  max_iterations: -5\n",
+              "odometry.max_iterations: wrong type: expected an integer in [1, 10000], got '-5'");
+  expectError("? [a, b]\n: 1\n", "the top level: a key that is a list");
+  std::filesystem::remove_all(dir);
 }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "semsegmap/core/atomic_file.h"
@@ -12,6 +13,7 @@
 #include "semsegmap/io/map_file.h"
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/target_map.h"
+#include "semsegmap/pipeline/map_parameters.h"
 
 namespace semsegmap {
 namespace {
@@ -129,6 +131,118 @@ TEST(MapFile, AnotherFormatVersionIsRejectedWithItsNumber) {
   writeBytesAtomically(path, bytes);
   const std::string error = expectLoadError(path);
   EXPECT_NE(error.find("version " + std::to_string(other)), std::string::npos) << error;
+}
+
+// Re-signs `bytes` after a patch, so that only the patched value is wrong.
+void resign(std::string& bytes) {
+  const uint64_t sum = fnv1a64(bytes.data(), bytes.size() - 8, kProjectFnvSeed);
+  std::memcpy(&bytes[bytes.size() - 8], &sum, sizeof(sum));
+}
+
+TEST(MapFile, Version1IsRefusedAskingToRebuild) {
+  const auto path = tempPath("version1.map");
+  saveTargetMap(path, randomMap(5, 8, false));
+  std::string bytes = readFileBytes(path);
+  const uint32_t one = 1;
+  std::memcpy(&bytes[8], &one, sizeof(one));
+  writeBytesAtomically(path, bytes);
+  const std::string error = expectLoadError(path);
+  EXPECT_EQ(error.rfind(path.string() + ": map format version 1", 0), 0u) << error;
+  EXPECT_NE(error.find("rebuild the map with `semsegmap map`"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos);
+}
+
+TEST(MapFile, RecordsTheSettingsItWasBuiltWith) {
+  TargetMap map = randomMap(20, 8, true);
+  PipelineConfig config;
+  config.segmentation.d_segment_m = 0.25;
+  map.parameters = mapParametersOf(config);
+  const auto path = tempPath("parameters.map");
+  const uint64_t with = saveTargetMap(path, map);
+  const TargetMap back = loadTargetMap(path);
+  EXPECT_EQ(back.parameters, map.parameters);
+  EXPECT_TRUE(mapParameterDifferences(back.parameters, mapParametersOf(config)).empty());
+  TargetMap bare = map;
+  bare.parameters.clear();
+  EXPECT_LT(with - saveTargetMap(path, bare), 1200u) << "the settings stay small";
+  EXPECT_TRUE(loadTargetMap(path).parameters.empty());
+}
+
+// The file offset of the first segment of a map with these strings and no parameters.
+size_t firstSegmentOffset(const TargetMap& map) {
+  return 8 + 4 + 4 + 1 + map.descriptor.size() + 1 + map.fingerprint.size() + 4 + 2 + 8;
+}
+
+// A NaN centroid, descriptor or point used to load and localize with exit 0 and "mean error
+// 0.00 m"; saving refuses it too, so the file here is patched by hand.
+TEST(MapFile, NonFiniteValuesAreRefusedNamingTheSegment) {
+  const TargetMap map = randomMap(4, 8, true);
+  const auto path = tempPath("finite.map");
+  EXPECT_NO_THROW(saveTargetMap(path, map));
+  MapWriteOptions f32;
+  f32.float16 = false;
+  saveTargetMap(path, map, f32);
+  const std::string good = readFileBytes(path);
+  const size_t segment = 12 + 4 + 2 + 8 * 4;
+  const size_t second = firstSegmentOffset(map) + segment;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  auto patched = [&](size_t at, const void* value, size_t size) {
+    std::string bytes = good;
+    std::memcpy(&bytes[at], value, size);
+    resign(bytes);
+    writeBytesAtomically(path, bytes);
+    return expectLoadError(path);
+  };
+  EXPECT_EQ(patched(second + 4, &nan, 4), path.string() + ": segment 1: non-finite centroid");
+  EXPECT_EQ(patched(second + 18 + 12, &inf, 4),
+            path.string() + ": segment 1: non-finite descriptor");
+  const uint16_t half_inf = 0x7c00;  // the points are float16 offsets: count, then x y z
+  EXPECT_EQ(patched(firstSegmentOffset(map) + 4 * segment + 2 + 2, &half_inf, 2),
+            path.string() + ": segment 0: non-finite point");
+
+  TargetMap bad = map;
+  bad.descriptors(2, 3) = nan;
+  try {
+    saveTargetMap(path, bad);
+    ADD_FAILURE() << "a NaN descriptor was saved";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": segment 2: non-finite descriptor");
+  }
+}
+
+TEST(MapParameters, DifferencesNameTheKeyAndBothValues) {
+  PipelineConfig built, running;
+  running.segmentation.d_segment_m = 0.5;
+  running.local_map.voxel_size_m = 0.2;
+  const auto d = mapParameterDifferences(mapParametersOf(built), mapParametersOf(running));
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0].key, "local_map.voxel_size_m");
+  EXPECT_EQ(d[0].map_value, "0.1");
+  EXPECT_EQ(d[0].config_value, "0.2");
+  EXPECT_EQ(describeDifference("m.map", d[1]),
+            "m.map: segmentation.d_segment_m: the map was built with 0.3, the configuration has "
+            "0.5");
+  // A key the map lacks (an older build recorded fewer) or has extra is a difference too.
+  MapParameters fewer = mapParametersOf(built);
+  fewer.pop_back();
+  fewer.emplace_back("segmentation.future_key", "1");
+  const auto e = mapParameterDifferences(fewer, mapParametersOf(built));
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_EQ(e[0].map_value, "(none)");
+  EXPECT_EQ(e[1].key, "segmentation.future_key");
+  EXPECT_EQ(e[1].config_value, "(none)");
+  EXPECT_TRUE(mapParameterDifferences({}, {}).empty());
+}
+
+TEST(MapParameters, TheBuilderRecordsThem) {
+  TargetMapBuilder builder("eigen", "x", 2);
+  PipelineConfig config;
+  builder.setParameters(mapParametersOf(config));
+  builder.add(MapSegment{}, Eigen::Vector2f(1, 0));
+  const TargetMap map = builder.build();
+  EXPECT_EQ(map.parameters, mapParametersOf(config));
+  EXPECT_GE(map.parameters.size(), 20u);
 }
 
 TEST(MapFile, CompatibilityNamesWhatDiffers) {

@@ -162,6 +162,29 @@ TEST(Trajectory, S3IsS2Reversed) {
   EXPECT_LT(translationError(s3.T_world_base.front(), s2.T_world_base.back()), 8.0);
 }
 
+TEST(Trajectory, LapsDriveTheLoopAgainWithoutAJump) {
+  const Trajectory one = makeTrajectory(fullWorld().roads, Run::S2, {}, {}, 1);
+  TrajectoryConfig three_laps;
+  three_laps.laps = 3;
+  const Trajectory three = makeTrajectory(fullWorld().roads, Run::S2, three_laps, {}, 1);
+  EXPECT_NEAR(three.length_m, 3.0 * one.length_m, 1e-6);
+  EXPECT_NEAR(static_cast<double>(three.T_world_base.size()), 3.0 * one.T_world_base.size(), 3.0);
+  // Frames stay 1 m apart through the seams between laps, and time goes on.
+  for (size_t k = 1; k < three.T_world_base.size(); ++k) {
+    ASSERT_NEAR(translationError(three.T_world_base[k - 1], three.T_world_base[k]), 1.0, 0.1)
+        << "frame " << k;
+    ASSERT_LT(rotationErrorDeg(three.T_world_base[k - 1], three.T_world_base[k]), 15.0);
+    ASSERT_GT(three.timestamps_s[k], three.timestamps_s[k - 1]);
+  }
+  // The second lap drives the first one's streets, with odometry for every frame.
+  const size_t n = one.T_world_base.size();
+  EXPECT_LT(translationError(three.T_world_base[n + 100], one.T_world_base[100]), 1.5);
+  EXPECT_EQ(three.T_odom_base.size(), three.T_world_base.size());
+  // A run that does not end where it starts has no laps.
+  EXPECT_THROW(makeTrajectory(fullWorld().roads, Run::S1, three_laps, {}, 1),
+               std::invalid_argument);
+}
+
 TEST(Trajectory, S1RevisitsPlaces) {
   const Trajectory t = makeTrajectory(fullWorld().roads, Run::S1, {}, {}, 1);
   // Count frames that come within 4 m of a frame at least 200 frames earlier.

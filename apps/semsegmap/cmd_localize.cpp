@@ -13,23 +13,48 @@
 #include "semsegmap/io/map_file.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/io/run_output.h"
+#include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/modes.h"
 
 namespace semsegmap::app {
 
 namespace {
 
+// The map's recorded build settings against the configuration's, before the data is opened: a
+// map grown with another voxel size or growing radius holds segments the run never makes, and
+// localized nothing with exit 0. --allow-config-mismatch goes on, listing every difference.
+void checkMapSettings(const std::filesystem::path& map_path, const TargetMap& map,
+                      const PipelineConfig& config, bool allow_mismatch) {
+  const auto differences = mapParameterDifferences(map.parameters, mapParametersOf(config));
+  if (differences.empty()) return;
+  if (!allow_mismatch)
+    throw std::runtime_error(describeDifference(map_path.string(), differences.front()) +
+                             " (rebuild the map with this configuration, or give "
+                             "--allow-config-mismatch)");
+  std::cerr << "warning: --allow-config-mismatch: localizing against a map built with other "
+               "settings ("
+            << differences.size() << "):\n";
+  for (const MapParameterDifference& d : differences)
+    std::cerr << "warning:   " << describeDifference(map_path.string(), d) << "\n";
+}
+
 int runLocalize(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
   const std::filesystem::path map_path = a.get("map");
   const std::filesystem::path out = a.get("out");
   const auto map = std::make_shared<const TargetMap>(loadTargetMap(map_path));
+  checkMapSettings(map_path, *map, config, a.has("allow-config-mismatch"));
+  // The kind before the data; the model, which may follow from the data's modalities
+  // (chooseDescriptor), is compared once the describer is made, still before any frame.
+  const std::string kind = descriptorName(parseDescriptorKind(config.descriptor.kind));
+  if (map->descriptor != kind)
+    throw std::runtime_error(map_path.string() + ": map built with " + map->descriptor +
+                             " descriptors, the configuration uses " + kind);
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
   auto source = openDatasetArg(a);
   std::shared_ptr<Describer> describer = describerFor(config.descriptor, *source);
   checkMapCompatible(map_path, *map, descriptorName(describer->kind()), describer->fingerprint(),
                      describer->dimension());
-  std::filesystem::create_directories(out);
 
   Progress progress("localize", 0);
   RunOptions options;
@@ -39,6 +64,9 @@ int runLocalize(const CliArgs& a) {
 
   writeLocalizationsCsv(out / "localizations.csv", run);
   writeLocalizationDetails(out, run);  // matches.csv, trajectory.csv: for semsegmap view
+  writeLocalizationPicture(out / "localization.png", run, *map,
+                           source->info().name + " against " + map_path.filename().string() + " (" +
+                               std::filesystem::path(a.get("config")).stem().string() + ")");
   SummaryContext context;
   context.dataset = source->info().name;
   context.map = map_path.string();
@@ -46,15 +74,15 @@ int runLocalize(const CliArgs& a) {
   context.descriptor = map->descriptor;
   context.map_segments = map->size();
   context.map_bytes = std::filesystem::file_size(map_path);
+  // Last: a summary says the run completed.
   writeBytesAtomically(out / "summary.json", localizationSummaryJson(run, context));
-  writeLocalizationPicture(out / "localization.png", run, *map,
-                           source->info().name + " against " + map_path.filename().string() + " (" +
-                               std::filesystem::path(a.get("config")).stem().string() + ")");
 
   const LocalizationSummary s = summarize(run.localizations);
   if (run.trajectory_gt.empty())  // errors need ground truth; zeros would read as perfect
     std::printf("frames %zu  localizations %zu  (no ground truth: errors unknown)  %.1f Hz\n",
                 run.stats.frames, s.localizations, run.stats.fps());
+  else if (s.localizations == 0)  // no mean of nothing: "0.00 m" would read as perfect
+    std::printf("frames %zu  localizations 0  %.1f Hz\n", run.stats.frames, run.stats.fps());
   else
     std::printf(
         "frames %zu  localizations %zu  <1 m %zu  <5 m %zu  mean error %.2f m %.2f deg  "
@@ -79,6 +107,8 @@ const CommandSpec& localizeCommand() {
               {"map", Value::kText, "MAP", "", "the target map (semsegmap map)", kRequired},
               {"out", Value::kText, "DIR", "", "output folder", kRequired},
               maxFramesOption(),
+              {"allow-config-mismatch", Value::kFlag, "", "",
+               "localize even when the map was built with other settings (listed on stderr)"},
           }),
       kDatasetNotes, runLocalize};
   return command;

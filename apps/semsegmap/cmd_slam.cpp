@@ -31,8 +31,6 @@ int runSlamCommand(const CliArgs& a) {
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   const SlamRun run = runSlam(*source, config, describer, options);
-  // Made only now: a run refused up front (a dataset without odometry) leaves nothing behind.
-  std::filesystem::create_directories(out);
 
   writeTum(out / "trajectory_tum.txt", run.trajectory);
   writeKitti(out / "trajectory_kitti.txt", run.trajectory);
@@ -43,9 +41,6 @@ int runSlamCommand(const CliArgs& a) {
       o << l.frame_index << ',' << l.old_frame_index << ',' << l.inliers << ',' << l.correction_m
         << '\n';
   });
-  // summary.json: counts, speed and (with ground truth) the trajectory error before and after
-  // loop closure, which is also printed.
-  writeBytesAtomically(out / "summary.json", slamSummaryJson(run, source->info().name));
   const std::optional<SlamErrors> errors = slamErrors(run);
   const bool has_gt = errors.has_value();
   if (errors)
@@ -63,6 +58,9 @@ int runSlamCommand(const CliArgs& a) {
                        run.trajectory.at(l.node).T.translation());
   viz::writeTrajectoriesPng(out / "slam.png", source->info().name + " - loop closure", curves,
                             links);
+  // Last: a summary says the run completed. Counts, speed and (with ground truth) the trajectory
+  // error before and after loop closure.
+  writeBytesAtomically(out / "summary.json", slamSummaryJson(run, source->info().name));
   std::printf("frames %zu  loop closures %zu  map segments %zu  %.1f Hz\n", run.stats.frames,
               run.loops.size(), run.map.size(), run.stats.fps());
   std::cout << "wrote " << (out / "trajectory_tum.txt").string()

@@ -58,6 +58,8 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesys
     options.class_maps_dir = shippedFile("config/class_maps");
   if (a.has("ground-truth")) options.ground_truth = a.get("ground-truth");
   if (a.has("kitti-calib")) options.kitti_calib = a.get("kitti-calib");
+  // Only the frames the run reads are checked up front: --max-frames 1 on a long recording.
+  if (declares("max-frames")) options.frames_to_check = a.frameLimit();
   return openDataset(a.get("dataset"), options);
 }
 

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "progress.h"
+#include "semsegmap/io/run_output.h"
 
 #ifndef SEMSEGMAP_VERSION
 #error "SEMSEGMAP_VERSION comes from apps/semsegmap/CMakeLists.txt (the CMake project version)"
@@ -129,6 +131,20 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
 #endif
 }
 
+// What a command writes: --out and the options naming another file it writes; a DIR placeholder
+// says a folder. Checked before the command starts, removed again when it fails.
+void declareOutputs(const CliArgs& a, RunOutputs& outputs) {
+  for (const OptionSpec& o : a.command().options) {
+    const bool output = o.name == "out" || o.name == "ply" || o.name == "history" ||
+                        (o.name == "cameras" && o.placeholder == "FILE.png");
+    if (!output || (!a.has(o.name) && o.fallback.empty())) continue;
+    if (o.placeholder == "DIR")
+      outputs.folder(a.get(o.name), "--" + o.name);
+    else
+      outputs.file(a.get(o.name), "--" + o.name);
+  }
+}
+
 int usageError(const std::string& name, const std::string& message) {
   const std::string prefix = name.empty() ? "semsegmap" : "semsegmap " + name;
   std::cerr << prefix << ": usage error: " << message << "\nrun '" << prefix << " --help' for "
@@ -158,10 +174,16 @@ int run(const std::vector<std::string>& args) {
       return 0;
     }
     const CliArgs parsed(*command, rest);
-    return command->run(parsed);
+    RunOutputs outputs;  // a failed command leaves none of its outputs behind
+    declareOutputs(parsed, outputs);
+    const int code = command->run(parsed);
+    if (code == 0) outputs.commit();
+    return code;
   } catch (const UsageError& e) {
+    endProgressLine();
     return usageError(name, e.what());
   } catch (const std::exception& e) {
+    endProgressLine();  // the error on a line of its own, not glued to a progress bar
     std::cerr << "semsegmap " << name << ": error: " << e.what() << "\n";
     return 1;
   }

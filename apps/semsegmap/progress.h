@@ -17,6 +17,20 @@ inline bool stderrIsTerminal() {
   return isatty(fileno(stderr)) != 0;
 }
 
+// Whether a progress line is drawn on the terminal and not yet ended: what is printed next on
+// stderr (an error) must start on a line of its own, not after the bar.
+inline bool& progressLineOpen() {
+  static bool open = false;
+  return open;
+}
+
+// Ends a progress line left open, so that the next message starts at the left margin.
+inline void endProgressLine() {
+  if (!progressLineOpen()) return;
+  std::fputc('\n', stderr);
+  progressLineOpen() = false;
+}
+
 // When and how a progress line is written; the text is up to its user.
 class ProgressLine {
  public:
@@ -43,6 +57,7 @@ class ProgressLine {
       std::fprintf(stderr, "\r%s   %s", text.c_str(), last ? "\n" : "");
     else
       std::fprintf(stderr, "%s\n", text.c_str());
+    progressLineOpen() = terminal_ && !last;
     std::fflush(stderr);
   }
 

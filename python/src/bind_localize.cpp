@@ -7,6 +7,7 @@
 #include "semsegmap/io/map_file.h"
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/target_map.h"
+#include "semsegmap/pipeline/map_parameters.h"
 
 namespace semsegmap::python {
 
@@ -42,11 +43,20 @@ void bindMapSegment(py::module_& m) {
           "(K, 3) float32 (a copy): optional points, map frame");
 }
 
+py::dict parametersDict(const MapParameters& parameters) {
+  py::dict d;
+  for (const auto& [key, value] : parameters) d[py::str(key)] = value;
+  return d;
+}
+
 void bindTargetMap(py::module_& m) {
   py::class_<TargetMap, std::shared_ptr<TargetMap>>(
       m, "TargetMap", "What a robot localizes against (localize/target_map.h); read-only")
       .def_readonly("descriptor", &TargetMap::descriptor, "the describer's kind")
       .def_readonly("fingerprint", &TargetMap::fingerprint)
+      .def_property_readonly(
+          "parameters", [](const TargetMap& map) { return parametersDict(map.parameters); },
+          "dict of the settings the map was built with (pipeline/map_parameters.h), a copy")
       .def("__len__", &TargetMap::size)
       .def_property_readonly("dimension", &TargetMap::dimension)
       .def_property_readonly(
@@ -92,6 +102,12 @@ void bindBuilder(py::module_& m) {
            py::arg("config") = TargetMapBuilderConfig{})
       .def("add", &TargetMapBuilder::add, py::arg("segment"), py::arg("descriptor"),
            "ValueError for a descriptor of another dimension or a non-finite value")
+      .def(
+          "set_parameters",
+          [](TargetMapBuilder& b, const PipelineConfig& config) {
+            b.setParameters(mapParametersOf(config));
+          },
+          py::arg("config"), "records the settings of `config` in the maps it builds")
       .def_property_readonly("duplicates_removed", &TargetMapBuilder::duplicatesRemoved)
       .def("build",
            [](const TargetMapBuilder& b) { return std::make_shared<TargetMap>(b.build()); });
@@ -170,6 +186,18 @@ void bindLocalize(py::module_& m) {
       },
       py::arg("map"), py::arg("describer"), py::arg("name") = "target map",
       "RuntimeError when the map's descriptors cannot be compared with the describer's");
+  m.def(
+      "map_parameters",
+      [](const PipelineConfig& config) { return parametersDict(mapParametersOf(config)); },
+      py::arg("config"), "dict of the settings of `config` a map records");
+  m.def(
+      "check_map_parameters",
+      [](const TargetMap& map, const PipelineConfig& config, const std::string& name) {
+        const auto d = mapParameterDifferences(map.parameters, mapParametersOf(config));
+        if (!d.empty()) throw std::runtime_error(describeDifference(name, d.front()));
+      },
+      py::arg("map"), py::arg("config"), py::arg("name") = "target map",
+      "RuntimeError naming the first setting the map was built with otherwise than `config`");
 }
 
 }  // namespace semsegmap::python

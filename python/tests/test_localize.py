@@ -70,6 +70,25 @@ def test_save_and_load_round_trip(tmp_dir, float16):
     assert back.segment(0).points.shape == (5, 3)
 
 
+def test_a_map_records_the_settings_it_was_built_with(tmp_dir):
+    built = ssm.PipelineConfig()
+    b = ssm.TargetMapBuilder("eigen", "test", DIM)
+    b.set_parameters(built)
+    b.add(ssm.MapSegment(centroid=np.zeros(3, np.float32)), np.ones(DIM, np.float32))
+    path = os.path.join(tmp_dir, "settings.map")
+    ssm.save_map(path, b.build())
+    back = ssm.load_map(path)
+    assert back.parameters == ssm.map_parameters(built)
+    assert back.parameters["segmentation.d_segment_m"] == "0.3"
+    ssm.check_map_parameters(back, built)
+    other = ssm.PipelineConfig()
+    other.segmentation.d_segment_m = 0.5
+    with pytest.raises(RuntimeError) as e:
+        ssm.check_map_parameters(back, other, path)
+    assert one_line(e.value) == (path + ": segmentation.d_segment_m: the map was built with "
+                                 "0.3, the configuration has 0.5")
+
+
 def test_map_file_errors_name_the_file(tmp_dir):
     missing = os.path.join(tmp_dir, "none.map")
     with pytest.raises(RuntimeError) as e:

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -22,6 +23,22 @@ fs::path temporaryPathFor(const fs::path& path) {
   std::ostringstream name;
   name << '.' << path.filename().string() << ".tmp-" << ::getpid() << '-' << counter++;
   return path.parent_path() / name.str();
+}
+
+std::mutex& observerMutex() {
+  static std::mutex m;
+  return m;
+}
+std::function<void(const fs::path&)>& newFileObserver() {
+  static std::function<void(const fs::path&)> observer;
+  return observer;
+}
+
+// After the rename: `existed` is whether `path` was there before it.
+void reportNewFile(const fs::path& path, bool existed) {
+  if (existed) return;
+  const std::lock_guard<std::mutex> lock(observerMutex());
+  if (newFileObserver()) newFileObserver()(path);
 }
 
 void removeQuietly(const fs::path& path) {
@@ -46,15 +63,22 @@ void writeFileAtomically(const fs::path& path, const std::function<void(std::ost
     // Checked after close because a full disk often only shows when the last buffer is written.
     if (!out) throw std::runtime_error(path.string() + ": write failed (disk full?)");
     std::error_code ec;
+    const bool existed = fs::exists(path, ec);
     fs::rename(tmp, path, ec);
     if (ec)
       throw std::runtime_error(path.string() + ": cannot rename temporary file into place (" +
                                ec.message() + ")");
+    reportNewFile(path, existed);
   } catch (...) {
     // The callback's own exception is passed on unchanged: it knows best what went wrong.
     removeQuietly(tmp);
     throw;
   }
+}
+
+void setNewFileObserver(std::function<void(const fs::path&)> observer) {
+  const std::lock_guard<std::mutex> lock(observerMutex());
+  newFileObserver() = std::move(observer);
 }
 
 void writeBytesAtomically(const fs::path& path, const std::string& bytes) {

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "semsegmap/core/shown_text.h"
 namespace semsegmap {
 
 uint64_t fnv1a64(const void* data, size_t size, uint64_t seed) {
@@ -30,7 +31,7 @@ BinaryReader::BinaryReader(std::filesystem::path path, std::string_view bytes, s
     : path_(std::move(path)), bytes_(bytes), format_(std::move(format)), end_(bytes.size()) {}
 
 void BinaryReader::fail(const std::string& what) const {
-  throw std::runtime_error(path_.string() + ": " + what);
+  throw std::runtime_error(path_.string() + ": " + shownText(what, std::string::npos));
 }
 
 void BinaryReader::need(size_t count, size_t element_bytes, const char* field) const {

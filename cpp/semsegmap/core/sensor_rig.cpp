@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace semsegmap {
 
@@ -144,37 +145,62 @@ bool isFinitePose(const Pose& T) {
 }
 }  // namespace
 
-void SensorRig::validate() const {
-  auto fail = [](const std::string& what) { throw std::invalid_argument("sensor rig: " + what); };
-  if (lidar.columns <= 0 || lidar.rows <= 0) fail("lidar.columns and lidar.rows must be positive");
-  if (!(lidar.hfov_deg > 0 && lidar.hfov_deg <= 360)) fail("lidar.hfov_deg must be in (0, 360]");
-  if (!(lidar.vfov_up_deg > lidar.vfov_down_deg))
-    fail("lidar.vfov_up_deg must exceed vfov_down_deg");
-  if (!(lidar.max_range_m > lidar.min_range_m && lidar.min_range_m >= 0))
-    fail("lidar range must satisfy 0 <= min_range_m < max_range_m");
-  if (!(rate_hz > 0)) fail("rate_hz must be positive");
-  if (!isFinitePose(T_base_lidar)) fail("T_base_lidar has a NaN or infinite entry");
-  for (const auto& c : cameras) {
-    const std::string n = "camera '" + c.name + "': ";
-    if (c.width <= 0 || c.height <= 0) fail(n + "width and height must be positive");
-    if (!(c.fx > 0 && c.fy > 0) || !std::isfinite(c.fx) || !std::isfinite(c.fy))
-      fail(n + "focal lengths fx, fy must be positive and finite");
-    if (!(c.cx > -c.width && c.cx < 2.0 * c.width && c.cy > -c.height && c.cy < 2.0 * c.height))
-      fail(n + "principal point (cx, cy) lies far outside the image");
-    const Eigen::Matrix3d R = c.T_camera_lidar.linear();
-    if (!R.allFinite() || (R * R.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3 ||
-        R.determinant() < 0)
-      fail(n + "T_camera_lidar rotation is not a proper rotation matrix");
-    if (!isFinitePose(c.T_camera_lidar)) fail(n + "T_camera_lidar has a NaN or infinite entry");
+namespace {
+
+[[noreturn]] void rigFail(const std::string& what) {
+  throw std::invalid_argument("sensor rig: " + what);
+}
+
+void validateLidar(const LidarModel& lidar) {
+  if (lidar.columns <= 0 || lidar.rows <= 0 || lidar.columns > kMaxLidarColumns ||
+      lidar.rows > kMaxLidarRows)
+    rigFail("lidar.columns and lidar.rows must be in 1.." + std::to_string(kMaxLidarColumns) +
+            " and 1.." + std::to_string(kMaxLidarRows));
+  if (!(lidar.hfov_deg > 0 && lidar.hfov_deg <= 360)) rigFail("lidar.hfov_deg must be in (0, 360]");
+  if (!(lidar.vfov_up_deg > lidar.vfov_down_deg) || !std::isfinite(lidar.vfov_up_deg) ||
+      !std::isfinite(lidar.vfov_down_deg))
+    rigFail("lidar.vfov_up_deg must exceed vfov_down_deg, both finite");
+  if (!(lidar.max_range_m > lidar.min_range_m && lidar.min_range_m >= 0) ||
+      !std::isfinite(lidar.max_range_m))
+    rigFail("lidar range must satisfy 0 <= min_range_m < max_range_m < infinity");
+}
+
+void validateCamera(const Camera& c) {
+  const std::string n = "camera '" + c.name + "': ";
+  if (c.width <= 0 || c.height <= 0 || c.width > kMaxCameraSide || c.height > kMaxCameraSide)
+    rigFail(n + "width and height must be in 1.." + std::to_string(kMaxCameraSide) + ", got " +
+            std::to_string(c.width) + " x " + std::to_string(c.height));
+  if (!(c.fx > 0 && c.fy > 0) || !std::isfinite(c.fx) || !std::isfinite(c.fy))
+    rigFail(n + "focal lengths fx, fy must be positive and finite");
+  if (!(c.cx > -c.width && c.cx < 2.0 * c.width && c.cy > -c.height && c.cy < 2.0 * c.height))
+    rigFail(n + "principal point (cx, cy) lies far outside the image");
+  const Eigen::Matrix3d R = c.T_camera_lidar.linear();
+  if (!R.allFinite() || (R * R.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3 ||
+      R.determinant() < 0)
+    rigFail(n + "T_camera_lidar rotation is not a proper rotation matrix");
+  if (!isFinitePose(c.T_camera_lidar)) rigFail(n + "T_camera_lidar has a NaN or infinite entry");
+  for (double d : c.distortion)
+    if (!std::isfinite(d)) rigFail(n + "distortion coefficients must be finite");
+  if (c.model == CameraModel::kPinhole)
     for (double d : c.distortion)
-      if (!std::isfinite(d)) fail(n + "distortion coefficients must be finite");
-    if (c.model == CameraModel::kPinhole)
-      for (double d : c.distortion)
-        if (d != 0.0)
-          fail(n + "a pinhole camera has no distortion; set model: radtan or equidistant");
-    if (c.model == CameraModel::kEquidistant && c.distortion[4] != 0.0)
-      fail(n + "the equidistant model has four coefficients k1 k2 k3 k4");
-  }
+      if (d != 0.0)
+        rigFail(n + "a pinhole camera has no distortion; set model: radtan or equidistant");
+  if (c.model == CameraModel::kEquidistant && c.distortion[4] != 0.0)
+    rigFail(n + "the equidistant model has four coefficients k1 k2 k3 k4");
+}
+
+}  // namespace
+
+void SensorRig::validate() const {
+  validateLidar(lidar);
+  if (!(rate_hz > 0 && rate_hz <= 1000)) rigFail("rate_hz must be in (0, 1000]");
+  if (!isFinitePose(T_base_lidar)) rigFail("T_base_lidar has a NaN or infinite entry");
+  const Eigen::Matrix3d R = T_base_lidar.linear();
+  if ((R * R.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3 || R.determinant() < 0)
+    rigFail("T_base_lidar rotation is not a proper rotation matrix");
+  if (cameras.size() > kMaxCameras)
+    rigFail(std::to_string(cameras.size()) + " cameras, at most " + std::to_string(kMaxCameras));
+  for (const auto& c : cameras) validateCamera(c);
 }
 
 namespace {

@@ -60,6 +60,14 @@ struct Camera {
   }
 };
 
+// What a rig can have, checked by validate(): a rig read from a file larger than this is corrupt,
+// and its images or range images would be allocated whole (a 40000 x 40000 camera is 6 GB of
+// z-buffers a frame).
+constexpr int kMaxCameraSide = 16384;
+constexpr size_t kMaxCameras = 64;
+constexpr int kMaxLidarColumns = 1 << 16;
+constexpr int kMaxLidarRows = 1024;
+
 struct SensorRig {
   LidarModel lidar;
   Pose T_base_lidar = Pose::Identity();
@@ -67,7 +75,8 @@ struct SensorRig {
   double rate_hz = 5.0;
 
   // Throws std::invalid_argument naming the field when the rig cannot be right
-  // (non-positive sizes or focal lengths, a principal point far outside the image, ...).
+  // (sizes outside the limits above, non-positive or non-finite focal lengths, a principal point
+  // far outside the image, a non-finite pose or extrinsic, ...).
   void validate() const;
 };
 

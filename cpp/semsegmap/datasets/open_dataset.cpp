@@ -77,7 +77,12 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
       config.rig.lidar = lidarPresetOf(spec, value);
     else if (key == "classes")
       config.point_classes = parseUnsigned(spec, key, value) != 0;
-    else if (key == "sweep")
+    else if (key == "laps") {
+      const uint64_t laps = parseUnsigned(spec, key, value);
+      if (laps < 1 || laps > 1000)
+        throw std::invalid_argument("dataset '" + spec + "': laps is 1 to 1000, got " + value);
+      config.trajectory.laps = static_cast<int>(laps);
+    } else if (key == "sweep")
       config.lidar_sweep = parseUnsigned(spec, key, value) != 0;
     else if (key == "label_noise") {
       const uint64_t level = parseUnsigned(spec, key, value);
@@ -155,7 +160,7 @@ std::unique_ptr<FrameSource> openSource(const std::string& spec, const DatasetOp
     std::cerr << "note: " << spec << " has no meta.yaml: reading it as folder:" << spec << "\n";
     return openFolder("folder:" + spec, spec, options);
   }
-  return std::make_unique<DatasetReader>(spec);
+  return std::make_unique<DatasetReader>(spec, options.frames_to_check);
 }
 
 }  // namespace

@@ -39,6 +39,9 @@ struct DatasetOptions {
   // The config's semantics: section; with a model, the network labels pictures that have none.
   SemanticsConfig semantics;
   std::filesystem::path class_maps_dir;  // the shipped class maps (config/class_maps)
+  // The frames the run reads (--max-frames; 0: all): a dataset directory checks their rows and
+  // files before any frame is read (io/dataset_reader.h), and no more.
+  size_t frames_to_check = 0;
 };
 
 // Throws std::runtime_error / std::invalid_argument naming the spec and what was wrong. The

@@ -26,6 +26,9 @@ namespace {
 constexpr uint64_t kInferenceSalt = 0x5e35e63a9d1c0b7fULL;
 // Smaller chunks than this lose more to per-operation overhead than they gain in balance.
 constexpr size_t kMinChunk = 16;
+// Chunks a batch is cut into (before the limits above): four per thread on this project's
+// 2-core reference machine, where the shipped results were measured.
+constexpr size_t kChunksPerBatch = 8;
 
 // torch (and oneDNN) single-threaded in the calling thread for the guard's lifetime; the
 // caller's OpenMP thread count is restored, so its own parallel loops are untouched.
@@ -76,9 +79,12 @@ class LearnedDescriber : public Describer {
     const size_t n = batch.size();
     Eigen::MatrixXf out(static_cast<Eigen::Index>(n), dimension());
     // Threads take chunks from a shared counter, several each, so that a thread slowed down by
-    // another process on its core does not hold up the whole batch.
-    const size_t chunk = std::clamp(n / (4 * static_cast<size_t>(threads_)), kMinChunk,
-                                    static_cast<size_t>(kLearnedChunk));
+    // another process on its core does not hold up the whole batch. The chunks depend on the
+    // batch alone, never on the thread count: a segment's descriptor changes in its last bits
+    // with the other segments of its chunk (the network's matrix products are blocked by batch
+    // size), and a run must give the same files on a machine with more cores.
+    const size_t chunk =
+        std::clamp(n / kChunksPerBatch, kMinChunk, static_cast<size_t>(kLearnedChunk));
     const size_t chunks = (n + chunk - 1) / chunk;
     const size_t threads = std::min(static_cast<size_t>(threads_), chunks);
     std::atomic<size_t> next{0};

@@ -38,8 +38,19 @@ struct NetConfig {
 };
 
 // Throws std::invalid_argument naming the field when a value is out of range (e.g. a grid size
-// the decoder cannot reach by doubling).
+// the decoder cannot reach by doubling). The ranges are those a network on this project's CPU
+// budget can have, so that a corrupt model header is refused before anything is built.
 void validateNetConfig(const NetConfig& config);
+
+// The parameters of the network a (valid) configuration gives, by name and shape in the module's
+// registration order, as semsegmap_net.cpp and segmap_cnn.cpp build them: a model file is checked
+// against these before its network is built (tests/test_learned_net.cpp compares the two).
+struct TensorShape {
+  std::string name;
+  std::vector<int64_t> shape;
+  size_t numel() const;
+};
+std::vector<TensorShape> netTensorShapes(const NetConfig& config);
 
 struct ModelTensor {
   std::string name;  // the module's parameter or buffer name

@@ -40,10 +40,12 @@ void checkInputs(const Frame& frame, const SensorRig& rig) {
   }
   for (size_t c = 0; c < frame.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[c];
-    if (cam.width <= 0 || cam.height <= 0)
+    // Its z-buffer is allocated whole (SensorRig::validate has the same limit).
+    if (cam.width <= 0 || cam.height <= 0 || cam.width > kMaxCameraSide ||
+        cam.height > kMaxCameraSide)
       throw std::invalid_argument(where + "camera '" + cam.name + "': size " +
                                   std::to_string(cam.width) + "x" + std::to_string(cam.height) +
-                                  " is not positive");
+                                  " is outside 1.." + std::to_string(kMaxCameraSide));
     checkImage(frame, cam, frame.cameras[c].rgb, 3, "rgb");
     checkImage(frame, cam, frame.cameras[c].label, 1, "label");
   }
@@ -172,16 +174,20 @@ void projectPoints(const Frame& frame, const SensorRig& rig, std::vector<CameraV
   }
 }
 
-// Z-buffers: the nearest point per pixel, one camera per thread.
+// Z-buffers: the nearest point per pixel, one camera per thread. They are allocated here, before
+// the parallel loop: an allocation that fails inside an OpenMP region cannot be caught and
+// aborts the process, while here it is an exception the caller sees.
 void fillZBuffers(const SensorRig& rig, size_t n_points, std::vector<CameraView>& views,
                   size_t n_cams) {
+  for (size_t c = 0; c < n_cams; ++c) {
+    const size_t pixels = static_cast<size_t>(rig.cameras[c].width) * rig.cameras[c].height;
+    views[c].nearest.assign(pixels, -1);
+    views[c].nearest_depth.assign(pixels, std::numeric_limits<float>::infinity());
+  }
   const auto n = static_cast<std::ptrdiff_t>(n_points);
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_cams); ++c) {
     CameraView& view = views[c];
-    const size_t pixels = static_cast<size_t>(rig.cameras[c].width) * rig.cameras[c].height;
-    view.nearest.assign(pixels, -1);
-    view.nearest_depth.assign(pixels, std::numeric_limits<float>::infinity());
     for (std::ptrdiff_t i = 0; i < n; ++i) {
       const Projection& pr = view.points[i];
       if (pr.pixel < 0 || !(pr.depth < view.nearest_depth[pr.pixel])) continue;

@@ -1,12 +1,18 @@
 #include "semsegmap/io/config.h"
 
+#include "semsegmap/core/sensor_rig.h"
+#include "semsegmap/core/shown_text.h"
+
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 namespace semsegmap {
@@ -17,9 +23,79 @@ namespace {
 // config never silently leaves a default in place.
 using Setter = std::function<void(const YAML::Node&)>;
 
+constexpr long long kMaxPoints = 100000000;  // a limit for counts of points and segments
+
+// A value of the wrong type or out of range: readSection adds the file and the key.
+struct BadValue {
+  std::string what;
+};
+
+std::string shown(const YAML::Node& n) {
+  if (n.IsScalar()) return "'" + shownText(n.Scalar()) + "'";
+  if (n.IsSequence()) return "a list";
+  if (n.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+template <typename T>
+const char* expected() {
+  if constexpr (std::is_same_v<T, bool>) return "true or false";
+  if constexpr (std::is_same_v<T, std::string>) return "a string";
+  if constexpr (std::is_floating_point_v<T>) return "a finite number";
+  return "a list of finite numbers";
+}
+
+template <typename T>
+bool finite(const T& value) {
+  if constexpr (std::is_floating_point_v<T>) return std::isfinite(value);
+  if constexpr (std::is_same_v<T, std::vector<float>>)
+    return std::all_of(value.begin(), value.end(), [](float v) { return std::isfinite(v); });
+  return true;
+}
+
+template <typename T>
+T decode(const YAML::Node& n) {
+  T value{};
+  bool ok = n.IsScalar() || std::is_same_v<T, std::vector<float>>;
+  try {
+    ok = ok && YAML::convert<T>::decode(n, value) && finite(value);
+  } catch (const YAML::Exception&) {  // an element of a list that is no number
+    ok = false;
+  }
+  if (!ok) throw BadValue{std::string("expected ") + expected<T>() + ", got " + shown(n)};
+  return value;
+}
+
+// Counts go through count() with their limits, so that no count read from a file can make the
+// program allocate what it says (localization.k: 1000000000 was std::bad_alloc).
 template <typename T>
 Setter set(T& field) {
-  return [&field](const YAML::Node& n) { field = n.as<T>(); };
+  static_assert(!std::is_integral_v<T> || std::is_same_v<T, bool>, "counts are read by count()");
+  return [&field](const YAML::Node& n) { field = decode<T>(n); };
+}
+
+template <typename T>
+Setter count(T& field, long long lo, long long hi) {
+  return [&field, lo, hi](const YAML::Node& n) {
+    long long value = 0;
+    bool ok = n.IsScalar();
+    try {
+      ok = ok && YAML::convert<long long>::decode(n, value);
+    } catch (const YAML::Exception&) {
+      ok = false;
+    }
+    if (!ok || value < lo || value > hi)
+      throw BadValue{"expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                     "], got " + shown(n)};
+    field = static_cast<T>(value);
+  };
+}
+
+std::string keyOf(const std::filesystem::path& path, const YAML::Node& key,
+                  const std::string& where) {
+  if (!key.IsScalar())
+    throw std::runtime_error(path.string() + ": " + where + ": a key that is " + shown(key));
+  return shownText(key.Scalar(), std::string::npos);  // a key is shown in messages as it is
 }
 
 void readSection(const std::filesystem::path& path, const YAML::Node& root, const std::string& name,
@@ -29,15 +105,14 @@ void readSection(const std::filesystem::path& path, const YAML::Node& root, cons
   if (!section.IsMap())
     throw std::runtime_error(path.string() + ": " + name + ": expected a mapping");
   for (const auto& kv : section) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = keyOf(path, kv.first, name);
     auto it = keys.find(key);
     if (it == keys.end())
       throw std::runtime_error(path.string() + ": " + name + "." + key + ": unknown key");
     try {
       it->second(kv.second);
-    } catch (const YAML::Exception& e) {
-      throw std::runtime_error(path.string() + ": " + name + "." + key + ": wrong type (" + e.msg +
-                               ")");
+    } catch (const BadValue& e) {
+      throw std::runtime_error(path.string() + ": " + name + "." + key + ": wrong type: " + e.what);
     }
   }
 }
@@ -48,13 +123,18 @@ namespace {
 
 // The YAML document, whose top level may hold only the known sections.
 YAML::Node loadConfigRoot(const std::filesystem::path& path) {
-  if (!std::filesystem::exists(path))
+  std::error_code error;
+  if (!std::filesystem::exists(path, error))
     throw std::runtime_error(path.string() + ": no such config file");
+  if (!std::filesystem::is_regular_file(path, error))
+    throw std::runtime_error(path.string() + ": not a config file (a directory or a device)");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path.string() + ": not valid YAML (" + e.msg + ")");
+    throw std::runtime_error(path.string() + ": not valid YAML (" + shownText(e.msg) + ")");
+  } catch (const std::exception& e) {  // the stream's own errors
+    throw std::runtime_error(path.string() + ": cannot read (" + shownText(e.what()) + ")");
   }
   if (!root.IsMap())
     throw std::runtime_error(path.string() + ": expected a mapping at the top level");
@@ -63,7 +143,7 @@ YAML::Node loadConfigRoot(const std::filesystem::path& path) {
       {"localization", true}, {"target_map", true}, {"loop_closure", true}, {"odometry", true},
       {"semantics", true},    {"refinement", true}};
   for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = keyOf(path, kv.first, "the top level");
     if (!sections.count(key))
       throw std::runtime_error(path.string() + ": " + key + ": unknown section");
   }
@@ -124,16 +204,16 @@ void readOdometrySection(const std::filesystem::path& path, const YAML::Node& ro
               {{"voxel_size_m", set(c.voxel_size_m)},
                {"max_range_m", set(c.max_range_m)},
                {"min_range_m", set(c.min_range_m)},
-               {"max_points_per_voxel", set(c.max_points_per_voxel)},
+               {"max_points_per_voxel", count(c.max_points_per_voxel, 1, 10000)},
                {"initial_threshold_m", set(c.initial_threshold_m)},
                {"min_motion_m", set(c.min_motion_m)},
                {"deskew", set(c.deskew)},
-               {"min_points", set(c.min_points)},
+               {"min_points", count(c.min_points, 0, 100000000)},
                {"metric", set(metric)},
-               {"max_iterations", set(c.icp.max_iterations)},
+               {"max_iterations", count(c.icp.max_iterations, 1, 10000)},
                {"convergence", set(c.icp.convergence)},
                {"degeneracy_ratio", set(c.icp.degeneracy_ratio)},
-               {"min_correspondences", set(c.icp.min_correspondences)}});
+               {"min_correspondences", count(c.icp.min_correspondences, 0, 100000000)}});
   auto check = [&](bool ok, const std::string& what) {
     if (!ok) throw std::runtime_error(path.string() + ": odometry." + what);
   };
@@ -167,14 +247,14 @@ void readSemanticsSection(const std::filesystem::path& path, const YAML::Node& r
   readSection(path, root, "semantics",
               {{"model", set(c.model)},
                {"class_map", set(c.class_map)},
-               {"input_width", set(c.input_width)},
-               {"input_height", set(c.input_height)},
+               {"input_width", count(c.input_width, 0, kMaxCameraSide)},
+               {"input_height", count(c.input_height, 0, kMaxCameraSide)},
                {"resize", set(resize)},
                {"mean", set(mean)},
                {"std", set(stddev)},
                {"channel_order", set(order)},
                {"output", set(output)},
-               {"threads", set(c.threads)},
+               {"threads", count(c.threads, 0, 1024)},
                {"rate_hz", set(c.rate_hz)},
                {"tolerance_s", set(c.tolerance_s)},
                {"replace_dataset_labels", set(c.replace_dataset_labels)}});
@@ -229,7 +309,7 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
   const YAML::Node root = loadConfigRoot(path);
   PipelineConfig c;
   readSection(path, root, "enrichment",
-              {{"occlusion_radius_px", set(c.enrichment.occlusion_radius_px)},
+              {{"occlusion_radius_px", count(c.enrichment.occlusion_radius_px, 0, 100)},
                {"occlusion_tolerance_m", set(c.enrichment.occlusion_tolerance_m)},
                {"occlusion_tolerance_rel", set(c.enrichment.occlusion_tolerance_rel)}});
   auto& lm = c.local_map;
@@ -239,13 +319,13 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"dynamic_removal", set(dynamic_removal)},
                {"dynamic_vote_share", set(lm.dynamic_vote_share)},
                {"radius_m", set(lm.radius_m)},
-               {"min_points_per_voxel", set(lm.min_points_per_voxel)},
+               {"min_points_per_voxel", count(lm.min_points_per_voxel, 1, 1000000)},
                {"remove_dynamic_classes", set(lm.remove_dynamic_classes)},
                {"remove_ground_classes", set(lm.remove_ground_classes)},
                {"remove_unknown_class", set(lm.remove_unknown_class)},
                {"geometric_ground_removal", set(lm.geometric_ground_removal)},
                {"ground_cell_size_m", set(lm.ground.cell_size_m)},
-               {"ground_neighbourhood_cells", set(lm.ground.neighbourhood_cells)},
+               {"ground_neighbourhood_cells", count(lm.ground.neighbourhood_cells, 0, 100)},
                {"ground_height_above_m", set(lm.ground.height_above_m)}});
   try {
     if (!dynamic_removal.empty()) lm.dynamic_removal = parseDynamicRemoval(dynamic_removal);
@@ -258,8 +338,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"hue_threshold", set(sg.hue_threshold)},
                {"hue_penalty", set(sg.hue_penalty)},
                {"class_penalty", set(sg.class_penalty)},
-               {"min_segment_points", set(sg.min_segment_points)},
-               {"max_segment_points", set(sg.max_segment_points)},
+               {"min_segment_points", count(sg.min_segment_points, 0, kMaxPoints)},
+               {"max_segment_points", count(sg.max_segment_points, 0, kMaxPoints)},
                {"observation_growth", set(sg.observation_growth)},
                {"keep_all_observation_points", set(sg.keep_all_observation_points)}});
 
@@ -268,29 +348,29 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
               {{"kind", set(d.kind)},
                {"model", set(d.model)},
                {"model_lidar_only", set(d.model_lidar_only)},
-               {"batch", set(d.batch)}});
+               {"batch", count(d.batch, 1, 4096)}});
   d.model = besideConfig(path, d.model);
   d.model_lidar_only = besideConfig(path, d.model_lidar_only);
   auto& loc = c.localization;
   readSection(path, root, "localization",
-              {{"k", set(loc.localizer.index.k)},
-               {"exact_below", set(loc.localizer.index.exact_below)},
+              {{"k", count(loc.localizer.index.k, 1, 1000)},
+               {"exact_below", count(loc.localizer.index.exact_below, 0, kMaxPoints)},
                {"resolution_m", set(loc.localizer.verification.resolution_m)},
-               {"min_inliers", set(loc.localizer.verification.min_inliers)},
-               {"min_local_segments", set(loc.localizer.min_local_segments)},
-               {"every_n_frames", set(loc.every_n_frames)}});
+               {"min_inliers", count(loc.localizer.verification.min_inliers, 3, 10000)},
+               {"min_local_segments", count(loc.localizer.min_local_segments, 0, 1000000)},
+               {"every_n_frames", count(loc.every_n_frames, 1, 1000000)}});
   auto& rf = loc.refinement;
   readSection(path, root, "refinement",
               {{"enabled", set(rf.enabled)},
-               {"max_points_per_segment", set(rf.max_points_per_segment)},
+               {"max_points_per_segment", count(rf.max_points_per_segment, 1, 1000000)},
                {"coarse_distance_m", set(rf.coarse_distance_m)},
                {"fine_distance_m", set(rf.fine_distance_m)},
                {"kernel_scale_m", set(rf.kernel_scale_m)},
                {"max_correction_m", set(rf.max_correction_m)},
-               {"min_correspondences", set(rf.min_correspondences)}});
+               {"min_correspondences", count(rf.min_correspondences, 0, kMaxPoints)}});
   readSection(path, root, "target_map",
               {{"duplicate_distance_m", set(c.target_map.duplicate_distance_m)},
-               {"max_points_per_segment", set(c.target_map.max_points_per_segment)}});
+               {"max_points_per_segment", count(c.target_map.max_points_per_segment, 0, 1000000)}});
   auto& lc = c.loop_closure;
   readSection(path, root, "loop_closure",
               {{"exclude_recent_m", set(lc.exclude_recent_m)},

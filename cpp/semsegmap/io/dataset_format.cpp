@@ -127,6 +127,19 @@ Camera parseCamera(const YamlFields& p, const YAML::Node& node, const std::strin
   return cam;
 }
 
+// A sensor more than this far from the base (or the LiDAR from a camera) is no rig: such a pose
+// (1e308, say) is finite, so it passed, and the run found 0 segments with exit 0.
+constexpr double kMaxExtrinsicM = 100.0;
+
+void checkExtrinsic(const YamlFields& p, const std::string& field, const Pose& T) {
+  const Eigen::Vector3d t = T.translation();
+  if (!(t.stableNorm() <= kMaxExtrinsicM))  // stableNorm: 1e308 does not overflow to inf
+    p.fail(field + ": translation [" + formatExactDouble(t.x()) + ", " + formatExactDouble(t.y()) +
+           ", " + formatExactDouble(t.z()) + "] m: more than " + formatExactDouble(kMaxExtrinsicM) +
+           " m is no sensor rig");
+  if (!T.linear().allFinite()) p.fail(field + ": rotation is not finite");
+}
+
 SemanticClass parseClass(const YamlFields& p, const YAML::Node& node, const std::string& w) {
   p.expectMap(node, w);
   p.checkKeys(node, w, {"id", "name", "color", "dynamic", "ground"});
@@ -265,6 +278,10 @@ DatasetInfo readMetaYaml(const fs::path& path) {
   for (size_t i = 0; i < classes.size(); ++i)
     table.push_back(parseClass(p, classes[i], "classes[" + std::to_string(i) + "]"));
 
+  checkExtrinsic(p, "lidar.T_base_lidar", info.rig.T_base_lidar);
+  for (size_t i = 0; i < info.rig.cameras.size(); ++i)
+    checkExtrinsic(p, "cameras[" + std::to_string(i) + "].T_camera_lidar",
+                   info.rig.cameras[i].T_camera_lidar);
   try {
     info.classes = ClassTable(std::move(table));
     info.rig.validate();

@@ -1,5 +1,6 @@
 #include "semsegmap/io/kitti_calib.h"
 
+#include "semsegmap/core/shown_text.h"
 #include "semsegmap/io/dataset_format.h"
 
 #include <algorithm>
@@ -37,7 +38,7 @@ std::vector<double> parseNumbers(std::string_view text) {
     double value = 0.0;
     const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (ec != std::errc() || ptr != digits.data() + digits.size() || !std::isfinite(value))
-      throw std::invalid_argument("'" + std::string(token) + "' is not a finite number");
+      throw std::invalid_argument("'" + shownText(token) + "' is not a finite number");
     values.push_back(value);
     pos = end;
   }
@@ -71,7 +72,8 @@ KittiCalibFile::KittiCalibFile(const std::filesystem::path& path) : path_(path) 
 }
 
 std::runtime_error KittiCalibFile::error(const std::string& key, const std::string& problem) const {
-  return std::runtime_error(path_.string() + ": " + key + ": " + problem);
+  return std::runtime_error(path_.string() + ": " + shownText(key) + ": " +
+                            shownText(problem, std::string::npos));
 }
 
 const std::string& KittiCalibFile::text(const std::string& key) const {

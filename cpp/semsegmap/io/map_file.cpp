@@ -16,6 +16,8 @@ namespace {
 constexpr std::string_view kMagic("SSMMAP\r\n", 8);
 constexpr uint32_t kFlagFloat16 = 1u << 0;
 constexpr uint32_t kFlagPoints = 1u << 1;
+// A map records a few dozen settings; more is a corrupt count, refused before reading on.
+constexpr uint16_t kMaxParameters = 1024;
 
 void putHalf(BinaryWriter& w, float v) {
   w.put(Eigen::numext::bit_cast<uint16_t>(Eigen::half(v)));
@@ -23,6 +25,51 @@ void putHalf(BinaryWriter& w, float v) {
 float getHalf(BinaryReader& r, const char* field) {
   return static_cast<float>(
       Eigen::half(Eigen::half_impl::raw_uint16_to_half(r.get<uint16_t>(field))));
+}
+
+void putParameters(BinaryWriter& w, const std::filesystem::path& path, const MapParameters& p) {
+  if (p.size() > kMaxParameters)
+    throw std::invalid_argument(path.string() + ": more than " + std::to_string(kMaxParameters) +
+                                " map parameters");
+  w.put<uint16_t>(static_cast<uint16_t>(p.size()));
+  for (const auto& [key, value] : p) {
+    if (key.empty() || key.size() > 255 || value.size() > 255)
+      throw std::invalid_argument(path.string() + ": map parameter '" + key +
+                                  "': key must be 1..255 bytes, value at most 255");
+    w.putString8(key);
+    w.putString8(value);
+  }
+}
+
+MapParameters getParameters(BinaryReader& r) {
+  const uint16_t n = r.get<uint16_t>("the parameters");
+  if (n > kMaxParameters) r.fail("implausible parameter count " + std::to_string(n));
+  r.need(n, 2, "the parameters");  // an empty key and value take 2 bytes
+  MapParameters p;
+  for (uint16_t i = 0; i < n; ++i) {
+    std::string key = r.getString8("the parameters");
+    std::string value = r.getString8("the parameters");
+    if (key.empty()) r.fail("parameter " + std::to_string(i) + " has an empty key");
+    for (const auto& [k, v] : p)
+      if (k == key) r.fail("parameter " + key + " appears twice");
+    p.emplace_back(std::move(key), std::move(value));
+  }
+  return p;
+}
+
+// A NaN centroid or descriptor matches nothing and a NaN distance sorts anywhere: such a map
+// localized nothing and reported "mean error 0.00 m" instead of failing. Empty when all is finite.
+std::string firstNonFinite(const TargetMap& map) {
+  for (size_t i = 0; i < map.segments.size(); ++i) {
+    const MapSegment& s = map.segments[i];
+    const std::string segment = "segment " + std::to_string(i) + ": non-finite ";
+    if (!s.centroid.allFinite()) return segment + "centroid";
+    if (!map.descriptors.row(static_cast<Eigen::Index>(i)).allFinite())
+      return segment + "descriptor";
+    for (const Eigen::Vector3f& p : s.points)
+      if (!p.allFinite()) return segment + "point";
+  }
+  return {};
 }
 
 }  // namespace
@@ -33,6 +80,9 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
     throw std::invalid_argument(path.string() + ": map has " + std::to_string(map.segments.size()) +
                                 " segments but " + std::to_string(map.descriptors.rows()) +
                                 " descriptors");
+  // Refused here because the loader refuses it: a saved map always reads back.
+  if (const std::string bad = firstNonFinite(map); !bad.empty())
+    throw std::invalid_argument(path.string() + ": " + bad);
   bool points = false;
   for (const MapSegment& s : map.segments) points = points || !s.points.empty();
   BinaryWriter w;
@@ -42,6 +92,7 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
   w.putString8(map.descriptor);
   w.putString8(map.fingerprint);
   w.put<uint32_t>(static_cast<uint32_t>(map.dimension()));
+  putParameters(w, path, map.parameters);
   w.put<uint64_t>(map.segments.size());
   for (size_t i = 0; i < map.segments.size(); ++i) {
     const MapSegment& s = map.segments[i];
@@ -74,6 +125,9 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
   BinaryReader r(path, bytes, "map file");
   r.expectMagic(kMagic);
   const uint32_t version = r.get<uint32_t>("the header");
+  if (version == 1)
+    r.fail("map format version 1 records no build settings, this build reads version " +
+           std::to_string(kMapFormatVersion) + ": rebuild the map with `semsegmap map`");
   if (version != kMapFormatVersion)
     r.fail("map format version " + std::to_string(version) + ", this build reads version " +
            std::to_string(kMapFormatVersion) + " (rebuild the map with `semsegmap map`)");
@@ -86,6 +140,7 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
   map.fingerprint = r.getString8("the header");
   const uint32_t dim = r.get<uint32_t>("the header");
   if (dim == 0 || dim > 4096) r.fail("implausible descriptor dimension " + std::to_string(dim));
+  map.parameters = getParameters(r);
   const size_t per_segment = 12 + 4 + 2 + dim * ((flags & kFlagFloat16) ? 2 : 4);
   const uint64_t n = r.getCount(per_segment, "the segments");  // before allocating n of anything
   map.segments.resize(n);
@@ -108,6 +163,7 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
         for (int k = 0; k < 3; ++k) p[k] = s.centroid[k] + getHalf(r, "the points");
     }
   r.expectEnd("the segments");
+  if (const std::string bad = firstNonFinite(map); !bad.empty()) r.fail(bad);
   return map;
 }
 

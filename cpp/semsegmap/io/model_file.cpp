@@ -1,5 +1,6 @@
 #include "semsegmap/io/model_file.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -69,19 +70,28 @@ DescriptorKind getKind(BinaryReader& r, std::optional<DescriptorKind> expected) 
   return kind;
 }
 
-ModelTensor getTensor(BinaryReader& r) {
+std::string shapeText(const std::vector<int64_t>& shape) {
+  std::string text = "[";
+  for (size_t i = 0; i < shape.size(); ++i) text += (i ? ", " : "") + std::to_string(shape[i]);
+  return text + "]";
+}
+
+// The next tensor, which must be the one the configuration implies: its name and shape are
+// compared before its values are read (so a corrupt header can neither allocate nor build more
+// than the file holds), and every value must be finite.
+ModelTensor getTensor(BinaryReader& r, const TensorShape& expected) {
   ModelTensor t;
   t.name = r.getString32("a tensor name");
   const uint32_t rank = r.get<uint32_t>("a tensor shape");
   if (rank > 8) r.fail("corrupt model file: tensor " + t.name + " of rank " + std::to_string(rank));
   t.shape = r.getArray<int64_t>(rank, "a tensor shape");
-  size_t numel = 1;
-  for (const int64_t s : t.shape) {
-    if (s < 0 || s > (int64_t{1} << 31)) r.fail("corrupt model file: tensor " + t.name + " shape");
-    numel *= static_cast<size_t>(s);
-    r.need(numel, sizeof(float), "the weights");  // also bounds the product
-  }
-  t.values = r.getArray<float>(numel, "the weights");
+  if (t.name != expected.name || t.shape != expected.shape)
+    r.fail("weights do not match the configuration: " + t.name + " " + shapeText(t.shape) +
+           " in the file, " + expected.name + " " + shapeText(expected.shape) + " expected");
+  t.values = r.getArray<float>(expected.numel(), "the weights");
+  for (const float v : t.values)
+    if (!std::isfinite(v))
+      r.fail("corrupt weights: tensor " + t.name + " holds " + std::to_string(v));
   return t;
 }
 
@@ -123,7 +133,11 @@ Model readModelFile(const std::filesystem::path& path, std::optional<DescriptorK
   model.fingerprint = std::string(r.take(16, "the fingerprint"), 16);
   // A tensor takes at least its name's length, its rank and one float.
   const uint64_t count = r.getCount(12, "the tensor count");
-  for (uint64_t i = 0; i < count; ++i) model.tensors.push_back(getTensor(r));
+  const std::vector<TensorShape> shapes = netTensorShapes(model.config);
+  if (count != shapes.size())
+    r.fail("weights do not match the configuration: " + std::to_string(count) +
+           " tensors in the file, " + std::to_string(shapes.size()) + " expected");
+  for (const TensorShape& shape : shapes) model.tensors.push_back(getTensor(r, shape));
   r.expectEnd("the weights");
   return model;
 }

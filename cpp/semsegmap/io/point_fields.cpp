@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+
+#include "semsegmap/core/sensor_rig.h"
+#include "semsegmap/core/shown_text.h"
 
 namespace semsegmap {
 
@@ -73,12 +77,24 @@ const PointFieldSpec* findField(const std::vector<PointFieldSpec>& fields,
 void checkField(const PointFieldSpec& f, size_t point_step, const std::string& what) {
   const size_t size = typeSize(f.type);
   if (size == 0)
-    throw std::runtime_error(what + ": field '" + f.name + "' has the unknown datatype " +
+    throw std::runtime_error(what + ": field '" + shownText(f.name) +
+                             "' has the unknown datatype " +
                              std::to_string(static_cast<int>(f.type)));
   if (f.count == 0 || f.offset + size * f.count > point_step)
-    throw std::runtime_error(what + ": field '" + f.name + "' at offset " +
+    throw std::runtime_error(what + ": field '" + shownText(f.name) + "' at offset " +
                              std::to_string(f.offset) + " does not fit in the " +
                              std::to_string(point_step) + "-byte point record");
+}
+
+// The beam of a point: a ring beyond the LiDAR rows a rig can have is a corrupt record (and
+// would overflow the conversion to int).
+int ringOf(const PointFieldSpec& ring, const uint8_t* record, size_t i, const std::string& what) {
+  const double value = readValue(ring.type, record + ring.offset);
+  if (!(value >= 0 && value < kMaxLidarRows))
+    throw std::runtime_error(what + ": point " + std::to_string(i) + " has the ring " +
+                             std::to_string(value) + ", expected 0.." +
+                             std::to_string(kMaxLidarRows - 1));
+  return static_cast<int>(value);
 }
 
 }  // namespace
@@ -120,11 +136,12 @@ DecodedPoints decodePointFields(const std::vector<PointFieldSpec>& fields, size_
     const double v = intensity ? readValue(intensity->type, record + intensity->offset) : 0.0;
     out.points.push_back({static_cast<float>(x), static_cast<float>(y), static_cast<float>(z),
                           std::isfinite(v) ? static_cast<float>(v) : 0.0f});
-    if (ring)
-      out.rings =
-          std::max(out.rings, 1 + static_cast<int>(readValue(ring->type, record + ring->offset)));
+    if (ring) out.rings = std::max(out.rings, 1 + ringOf(*ring, record, i, what));
     if (time) {
       const double t = readValue(time->type, record + time->offset);
+      if (!std::isfinite(t))
+        throw std::runtime_error(what + ": point " + std::to_string(i) + " has the time " +
+                                 std::to_string(t) + " (field '" + shownText(time->name) + "')");
       // Floats beyond 1e15 are nanoseconds too: no clock counts seconds that high.
       out.times.push_back(time_in_ns || std::abs(t) > 1e15 ? t * 1e-9 : t);
     }

@@ -135,8 +135,8 @@ Camera parseCamera(const YamlFields& p, const YAML::Node& node, const std::strin
                "distortion", "T_camera_lidar", "T_lidar_camera"});
   Camera cam;
   cam.name = p.text(node, w, "name");
-  cam.width = static_cast<int>(p.integer(node, w, "width", 1, 1 << 16));
-  cam.height = static_cast<int>(p.integer(node, w, "height", 1, 1 << 16));
+  cam.width = static_cast<int>(p.integer(node, w, "width", 1, kMaxCameraSide));
+  cam.height = static_cast<int>(p.integer(node, w, "height", 1, kMaxCameraSide));
   parseIntrinsics(p, node, w, cam);
   parseLens(p, node, w, cam);
   if (!parseDirected(p, node, w, "camera", "lidar", cam.T_camera_lidar))

@@ -1,5 +1,6 @@
 #include "semsegmap/io/ros_decode.h"
 
+#include "semsegmap/core/shown_text.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/point_fields.h"
 
@@ -16,7 +17,7 @@ namespace semsegmap::rosmsg {
 namespace {
 
 [[noreturn]] void fail(const std::string& where, const std::string& what) {
-  throw std::runtime_error(where + ": " + what);
+  throw std::runtime_error(shownText(where + ": " + what, std::string::npos));
 }
 
 void checkCloudSizes(const PointCloud2& msg, const std::string& where) {
@@ -44,6 +45,8 @@ DecodedCloud decodePointCloud2(const PointCloud2& msg, const std::string& where)
   for (const PointField& f : msg.fields)
     fields.push_back({f.name, f.offset, static_cast<FieldType>(f.datatype), f.count});
   DecodedCloud out;
+  // Rows of no points hold nothing: billions of them would be decoded one by one.
+  if (msg.width == 0) return out;
   std::vector<double> times;
   for (uint32_t row = 0; row < msg.height; ++row) {
     const uint8_t* row_data = msg.data.data() + static_cast<size_t>(row) * msg.row_step;
@@ -116,7 +119,7 @@ semsegmap::Image decodeImage(const Image& msg, const std::string& where) {
 
 semsegmap::Image decodeCompressedImage(const CompressedImage& msg, const std::string& where) {
   return decodeColorImage(msg.data.data(), msg.data.size(),
-                          where + ": compressed image (format '" + msg.format + "')");
+                          where + ": compressed image (format '" + shownText(msg.format) + "')");
 }
 
 namespace {
@@ -162,6 +165,13 @@ void setLensModel(Camera& cam, const CameraInfo& msg, const std::string& where) 
 Camera cameraFromInfo(const CameraInfo& msg, const std::string& where) {
   if (msg.width == 0 || msg.height == 0)
     fail(where, "CameraInfo has no image size (width, height)");
+  if (msg.width > kMaxCameraSide || msg.height > kMaxCameraSide)
+    fail(where, "CameraInfo image size " + std::to_string(msg.width) + "x" +
+                    std::to_string(msg.height) + " is beyond " + std::to_string(kMaxCameraSide));
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (!std::all_of(msg.K.begin(), msg.K.end(), finite) ||
+      !std::all_of(msg.D.begin(), msg.D.end(), finite))
+    fail(where, "CameraInfo K or D holds a NaN or infinite value");
   Camera cam;
   cam.width = static_cast<int>(msg.width);
   cam.height = static_cast<int>(msg.height);
@@ -181,7 +191,7 @@ Pose poseOf(const Transform& t) {
   Pose T = Pose::Identity();
   T.translation() = Eigen::Vector3d(t.translation[0], t.translation[1], t.translation[2]);
   Eigen::Quaterniond q(t.rotation[3], t.rotation[0], t.rotation[1], t.rotation[2]);
-  if (!(q.norm() > 1e-6) || !T.translation().allFinite())
+  if (!q.coeffs().allFinite() || !(q.norm() > 1e-6) || !T.translation().allFinite())
     throw std::invalid_argument("transform with a zero or non-finite quaternion or translation");
   T.linear() = q.normalized().toRotationMatrix();  // recorded quaternions are rounded
   return T;

@@ -9,6 +9,7 @@
 #include <fastcdr/exceptions/Exception.h>
 
 #include "semsegmap/core/binary_io.h"
+#include "semsegmap/core/shown_text.h"
 
 namespace semsegmap::rosmsg {
 namespace {
@@ -112,7 +113,7 @@ class CdrReader {
     }
   }
   [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(msg_.file.string() + ": " + what);
+    throw std::runtime_error(msg_.file.string() + ": " + shownText(what, std::string::npos));
   }
 
   const SerializedMessage& msg_;

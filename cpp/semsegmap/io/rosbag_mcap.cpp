@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "semsegmap/core/binary_io.h"
+#include "semsegmap/core/shown_text.h"
 #include "semsegmap/io/rosbag_storage.h"
 
 namespace semsegmap::rosmsg {
@@ -47,7 +48,7 @@ class McapBag : public BagStorage {
 
  private:
   [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(path_.string() + ": " + what);
+    throw std::runtime_error(path_.string() + ": " + shownText(what, std::string::npos));
   }
   std::string readAt(uint64_t offset, uint64_t size, const char* what);
   const std::string& chunk(size_t index);
@@ -108,7 +109,8 @@ void McapBag::indexChunk(uint64_t at, uint64_t length) {
   place.compression = r.getString32("compression");
   place.compressed_size = r.get<uint64_t>("records");
   place.offset = at + 9 + r.position();
-  if (place.offset + place.compressed_size > at + 9 + length)
+  // Compared without a sum, which a corrupt size would wrap around.
+  if (place.compressed_size > at + 9 + length - place.offset)
     fail("corrupt MCAP chunk at byte " + std::to_string(at) + " (records past its end)");
   chunks_.push_back(place);
   const std::string& records = chunk(chunks_.size() - 1);
@@ -157,7 +159,7 @@ void McapBag::indexRecord(uint8_t op, std::string_view content, size_t chunk, ui
 }
 
 std::string McapBag::readAt(uint64_t offset, uint64_t size, const char* what) {
-  if (offset + size > file_size_)
+  if (size > file_size_ || offset > file_size_ - size)
     fail(std::string("truncated MCAP file (ends inside ") + what + ")");
   std::string bytes(size, '\0');
   in_.clear();

@@ -7,6 +7,7 @@
 #include <rosbag/query.h>
 #include <rosbag/view.h>
 
+#include <fstream>
 #include <map>
 #include <stdexcept>
 
@@ -17,9 +18,34 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// rosbag allocates each record's header and data lengths as it reads them (a corrupt length is
+// 4 GB), so the records' lengths are walked first: "#ROSBAG V2.0", then records of uint32 header
+// length, header, uint32 data length, data, each of which must end inside the file.
+void checkRecordLengths(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  const uint64_t size = fs::file_size(file);
+  std::string version(13, '\0');
+  if (!in.read(version.data(), 13) || version != "#ROSBAG V2.0\n")
+    throw std::runtime_error(file.string() + ": not a ROS 1 bag of format 2.0");
+  for (uint64_t at = 13; at < size;) {
+    const uint64_t record = at;
+    for (int part = 0; part < 2; ++part) {  // the header, then the data
+      uint32_t length = 0;
+      if (size - at < 4 || !in.read(reinterpret_cast<char*>(&length), 4) || length > size - at - 4)
+        throw std::runtime_error(file.string() +
+                                 ": truncated or corrupt ROS 1 bag (the record at " + "byte " +
+                                 std::to_string(record) + " ends past the end; an " +
+                                 "interrupted recording? `rosbag reindex` repairs it)");
+      at += 4 + length;
+      in.seekg(static_cast<std::streamoff>(at));
+    }
+  }
+}
+
 class Ros1Bag : public BagStorage {
  public:
   explicit Ros1Bag(const fs::path& file) : path_(file) {
+    checkRecordLengths(file);
     guard("not a readable ROS 1 bag", [&] {
       bag_.open(file.string(), rosbag::bagmode::Read);
       rosbag::View all(bag_);

@@ -1,7 +1,13 @@
 #include "semsegmap/io/run_output.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <system_error>
 
 #include "semsegmap/core/atomic_file.h"
 
@@ -69,8 +75,12 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   j["n_error_below_5m"] = s.below_5m;
   j["n_refined"] = std::count_if(run.localizations.begin(), run.localizations.end(),
                                  [](const LocalizationRecord& r) { return r.refined; });
-  j["mean_translation_error_m"] = s.mean_translation_error_m;
-  j["mean_rotation_error_deg"] = s.mean_rotation_error_deg;
+  // No localization, or no ground truth: the errors are unknown, not zero (which reads as perfect).
+  const bool errors_known = s.localizations > 0 && !run.trajectory_gt.empty();
+  j["mean_translation_error_m"] =
+      errors_known ? nlohmann::ordered_json(s.mean_translation_error_m) : nullptr;
+  j["mean_rotation_error_deg"] =
+      errors_known ? nlohmann::ordered_json(s.mean_rotation_error_deg) : nullptr;
   j["fps"] = run.stats.fps();
   j["stage_ms"] = stageMsJson(meanStageTimes(run.stats), true);
   j["map_segments"] = c.map_segments;
@@ -118,6 +128,133 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
   }
   j["has_ground_truth"] = errors.has_value();
   return jsonText(j);
+}
+
+// ---------------------------------------------------------------------------------------------
+// RunOutputs
+
+namespace {
+namespace fs = std::filesystem;
+
+// A folder with more entries than this is not listed (an output folder of /tmp): its new
+// subfolders are then left in place, and only the run's files are removed.
+constexpr size_t kMaxListedFolders = 20000;
+
+[[noreturn]] void refuse(const fs::path& path, const std::string& what, const std::string& why) {
+  throw std::runtime_error(path.string() + ": " + what + " " + why);
+}
+
+// access(2), not a trial write: nothing is written before the command starts; it also says
+// EROFS for a read-only file system. Root passes it for permissions, as it passes a write.
+void requireWritableDirectory(const fs::path& dir, const fs::path& path, const std::string& what) {
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    refuse(path, what, "cannot be written: " + dir.string() + ": " + std::strerror(errno));
+}
+
+// The nearest ancestor of `path` that exists (`path` itself when it does).
+fs::path nearestExisting(const fs::path& path) {
+  fs::path p = fs::absolute(path).lexically_normal();
+  std::error_code ec;
+  while (!fs::exists(p, ec) && p.has_relative_path()) p = p.parent_path();
+  return p;
+}
+
+bool inside(const fs::path& path, const fs::path& dir) {
+  const fs::path rel = path.lexically_relative(dir);
+  return !rel.empty() && rel != "." && *rel.begin() != "..";
+}
+
+fs::path normalized(const fs::path& path) {
+  return fs::absolute(path).lexically_normal();
+}
+
+}  // namespace
+
+RunOutputs::RunOutputs() {
+  setNewFileObserver([this](const fs::path& path) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    written_.push_back(normalized(path));
+  });
+}
+
+RunOutputs::~RunOutputs() {
+  setNewFileObserver({});
+  if (!committed_) removeCreated();
+}
+
+void RunOutputs::makeFolder(const fs::path& dir, const fs::path& shown, const std::string& what) {
+  const fs::path full = normalized(dir);
+  const fs::path ancestor = nearestExisting(full);
+  std::error_code ec;
+  if (!fs::is_directory(ancestor, ec))
+    refuse(shown, what, "cannot be created: " + ancestor.string() + " is not a directory");
+  requireWritableDirectory(ancestor, shown, what);
+  if (ancestor == full) return;
+  // The topmost folder made: removing it removes everything the run put below it.
+  fs::path top = full;
+  while (top.parent_path() != ancestor) top = top.parent_path();
+  fs::create_directories(full, ec);
+  if (ec) refuse(shown, what, "cannot be created: " + ec.message());
+  created_.push_back(top);
+}
+
+void RunOutputs::folder(const fs::path& dir, const std::string& what) {
+  const fs::path full = normalized(dir);
+  std::error_code ec;
+  if (fs::exists(full, ec) && !fs::is_directory(full, ec))
+    refuse(dir, what, "exists and is not a directory");
+  if (!fs::exists(full, ec)) {
+    makeFolder(full, dir, what);
+    return;
+  }
+  requireWritableDirectory(full, dir, what);
+  existing_.push_back(full);
+  size_t listed = 0;
+  for (auto it = fs::recursive_directory_iterator(full, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (++listed > kMaxListedFolders) {
+      listed_all_ = false;
+      break;
+    }
+    if (it->is_directory(ec)) old_dirs_.push_back(normalized(it->path()));
+  }
+}
+
+void RunOutputs::file(const fs::path& file, const std::string& what) {
+  const fs::path full = normalized(file);
+  std::error_code ec;
+  if (fs::is_directory(full, ec)) refuse(file, what, "is a directory, expected a file");
+  makeFolder(full.parent_path(), file, what);
+  if (!fs::exists(full, ec)) files_.push_back(full);
+}
+
+bool RunOutputs::newFolder(const fs::path& dir) const {
+  if (!listed_all_ || std::find(old_dirs_.begin(), old_dirs_.end(), dir) != old_dirs_.end())
+    return false;
+  for (const fs::path& d : existing_)
+    if (inside(dir, d)) return true;
+  return false;
+}
+
+bool RunOutputs::owns(const fs::path& path) const {
+  for (const fs::path& f : files_)
+    if (path == f) return true;
+  for (const fs::path& d : existing_)
+    if (path == d || inside(path, d)) return true;
+  return false;
+}
+
+void RunOutputs::removeCreated() noexcept {
+  std::error_code ec;
+  const std::lock_guard<std::mutex> lock(mutex_);
+  for (const fs::path& f : written_) {
+    if (!owns(f)) continue;  // a file outside the outputs (a training cache) is kept
+    fs::remove(f, ec);
+    // Up to the declared folder: subfolders that the run made and that are empty now.
+    for (fs::path d = f.parent_path(); newFolder(d); d = d.parent_path())
+      if (!fs::remove(d, ec)) break;  // not empty: something else lives there
+  }
+  for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove_all(*it, ec);
 }
 
 }  // namespace semsegmap

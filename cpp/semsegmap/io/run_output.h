@@ -1,10 +1,13 @@
 // The files a localization or SLAM run leaves behind: one CSV row per localization and JSON
-// summaries that evaluations across commits can compare.
+// summaries that evaluations across commits can compare; and RunOutputs, which checks a
+// command's outputs before it starts and removes them when it fails.
 #pragma once
 
 #include <filesystem>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "semsegmap/core/json.h"
 #include "semsegmap/graph/trajectory.h"
@@ -40,5 +43,44 @@ std::optional<SlamErrors> slamErrors(const SlamRun& run);
 
 // summary.json of a SLAM run: counts, speed and, with ground truth, the errors (slamErrors).
 std::string slamSummaryJson(const SlamRun& run, const std::string& dataset);
+
+// The outputs of one command. Declared before any work, each is checked at once: an output
+// folder must be a writable directory or creatable (its nearest existing ancestor a writable
+// directory), an output file must not be a directory and its folder likewise; the folders are
+// created then. Unless commit() is called (the command succeeded), the destructor removes what
+// the command created: folders that did not exist, and the files written atomically
+// (core/atomic_file.h) into a folder that did, with the subfolders that held only them. Nothing
+// that existed before is removed (a file the run replaced keeps its new content), so a failed run
+// leaves no summary of its own behind. One RunOutputs at a time per process.
+class RunOutputs {
+ public:
+  RunOutputs();
+  ~RunOutputs();
+  RunOutputs(const RunOutputs&) = delete;
+  RunOutputs& operator=(const RunOutputs&) = delete;
+
+  // Throw std::runtime_error "<path>: <what is wrong>" (`what` names the option, e.g. "--out").
+  void folder(const std::filesystem::path& dir, const std::string& what = "output folder");
+  void file(const std::filesystem::path& file, const std::string& what = "output file");
+  void commit() { committed_ = true; }
+
+ private:
+  // Creates `dir` and its missing ancestors; errors name `shown`, the output as given.
+  void makeFolder(const std::filesystem::path& dir, const std::filesystem::path& shown,
+                  const std::string& what);
+  bool owns(const std::filesystem::path& path) const;
+  // Inside an existing output folder and made by this run.
+  bool newFolder(const std::filesystem::path& dir) const;
+  void removeCreated() noexcept;
+
+  std::vector<std::filesystem::path> created_;   // the topmost folders this run made
+  std::vector<std::filesystem::path> existing_;  // declared folders that were there before
+  std::vector<std::filesystem::path> files_;     // declared files that were not
+  std::vector<std::filesystem::path> written_;   // new files the run wrote (the observer)
+  std::vector<std::filesystem::path> old_dirs_;  // folders inside existing_, before the run
+  bool listed_all_ = true;                       // old_dirs_ is complete
+  std::mutex mutex_;
+  bool committed_ = false;
+};
 
 }  // namespace semsegmap

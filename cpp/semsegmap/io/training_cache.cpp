@@ -6,6 +6,9 @@
 //   count x u8 colored.
 #include "semsegmap/io/training_cache.h"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
 #include <system_error>
 
 #include "semsegmap/core/atomic_file.h"
@@ -50,6 +53,11 @@ TrainingObservation getObservation(BinaryReader& r, size_t sources) {
   o.xyzhsv = r.getArray<float>(6 * size_t{n}, "the points of an observation");
   o.classes = r.getArray<ClassId>(n, "the points of an observation");
   o.colored = r.getArray<uint8_t>(n, "the points of an observation");
+  const auto finite = [](float v) { return std::isfinite(v); };
+  if (!std::isfinite(o.purity) || !o.centroid.allFinite() ||
+      !std::all_of(o.xyzhsv.begin(), o.xyzhsv.end(), finite))
+    r.fail("corrupt training cache (a non-finite value in the observation of segment " +
+           std::to_string(o.segment) + ")");
   return o;
 }
 

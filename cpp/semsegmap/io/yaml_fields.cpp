@@ -8,14 +8,16 @@ namespace semsegmap {
 YAML::Node loadYamlFile(const std::filesystem::path& path) {
   const YamlFields p(path);
   if (!std::filesystem::exists(path)) p.fail("missing");
-  if (std::filesystem::is_directory(path)) p.fail("is a directory, not a YAML file");
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    p.fail("is a directory or a device, not a YAML file");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());
   } catch (const YAML::ParserException& e) {
     p.fail("YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +
            std::to_string(e.mark.column + 1) + ": " + e.msg);
-  } catch (const YAML::Exception& e) {
+  } catch (const std::exception& e) {  // yaml-cpp's and the stream's own errors
     p.fail(std::string("cannot read: ") + e.what());
   }
   if (!root.IsMap()) p.fail("expected a YAML mapping at the top level");

@@ -14,6 +14,7 @@
 
 #include "semsegmap/core/pose.h"
 #include "semsegmap/core/sensor_rig.h"
+#include "semsegmap/core/shown_text.h"
 
 namespace semsegmap {
 
@@ -26,7 +27,7 @@ class YamlFields {
   explicit YamlFields(const std::filesystem::path& path) : path_(path.string()) {}
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(path_ + ": " + what);
+    throw std::runtime_error(path_ + ": " + shownText(what, std::string::npos));
   }
 
   void expectMap(const YAML::Node& node, const std::string& where) const {
@@ -119,7 +120,7 @@ class YamlFields {
   }
 
   static std::string describe(const YAML::Node& node) {
-    if (node.IsScalar()) return "'" + node.Scalar() + "'";
+    if (node.IsScalar()) return "'" + shownText(node.Scalar()) + "'";
     if (node.IsSequence()) return "a list";
     if (node.IsMap()) return "a mapping";
     return "nothing";

@@ -1,5 +1,6 @@
 #include "semsegmap/localize/target_map.h"
 
+#include <map>
 #include <stdexcept>
 
 namespace semsegmap {
@@ -40,6 +41,7 @@ TargetMap TargetMapBuilder::build() const {
   TargetMap map;
   map.descriptor = descriptor_;
   map.fingerprint = fingerprint_;
+  map.parameters = parameters_;
   size_t n = 0;
   for (bool a : alive_) n += a;
   map.descriptors.resize(static_cast<Eigen::Index>(n), dimension_);
@@ -79,6 +81,30 @@ void checkMapCompatible(const std::string& map_name, const TargetMap& map,
     throw std::runtime_error(where + "map built with model " + map.fingerprint +
                              ", the configuration's model is " + fingerprint +
                              " (rebuild the map with this model)");
+}
+
+std::vector<MapParameterDifference> mapParameterDifferences(const MapParameters& map,
+                                                            const MapParameters& config) {
+  const std::string none = "(none)";
+  const std::map<std::string, std::string> in_config(config.begin(), config.end());
+  std::map<std::string, std::string> in_map(map.begin(), map.end());
+  std::vector<MapParameterDifference> out;
+  // In the configuration's order, which is the order the map was written in by this build.
+  for (const auto& [key, value] : config) {
+    const auto it = in_map.find(key);
+    if (it == in_map.end())
+      out.push_back({key, none, value});
+    else if (it->second != value)
+      out.push_back({key, it->second, value});
+  }
+  for (const auto& [key, value] : map)
+    if (in_config.count(key) == 0) out.push_back({key, value, none});
+  return out;
+}
+
+std::string describeDifference(const std::string& map_name, const MapParameterDifference& d) {
+  return map_name + ": " + d.key + ": the map was built with " + d.map_value +
+         ", the configuration has " + d.config_value;
 }
 
 }  // namespace semsegmap

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -20,11 +21,19 @@ struct MapSegment {
   std::vector<Eigen::Vector3f> points;  // optional: a subsample, map frame
 };
 
+// The settings a map's segments depend on (voxel size, growing radius, penalties...), as
+// "section.key" -> value text in the configuration's own words: a map records them (map format
+// 2) because segments grown with other settings are other segments, whose descriptors do not
+// match even with the same model. Kept in a fixed order; values are exact (formatted to
+// round-trip), so equal text means equal settings.
+using MapParameters = std::vector<std::pair<std::string, std::string>>;
+
 struct TargetMap {
   std::string descriptor;   // descriptorName(): "semsegmap-net", "segmap-cnn", "eigen", "fpfh"
   std::string fingerprint;  // Describer::fingerprint(): the exact model the descriptors came from
   std::vector<MapSegment> segments;
   Eigen::MatrixXf descriptors;  // one row per segment
+  MapParameters parameters;     // what it was built with; empty for a map made by hand
 
   size_t size() const { return segments.size(); }
   int dimension() const { return static_cast<int>(descriptors.cols()); }
@@ -45,6 +54,8 @@ class TargetMapBuilder {
                    const TargetMapBuilderConfig& config = {});
   // `descriptor` has `dimension` entries; `points` may be empty.
   void add(const MapSegment& segment, const Eigen::VectorXf& descriptor);
+  // The settings the segments were made with (pipeline/map_parameters.h), copied into the map.
+  void setParameters(MapParameters parameters) { parameters_ = std::move(parameters); }
   size_t duplicatesRemoved() const { return duplicates_; }
   TargetMap build() const;
 
@@ -52,6 +63,7 @@ class TargetMapBuilder {
   std::string descriptor_, fingerprint_;
   int dimension_;
   TargetMapBuilderConfig config_;
+  MapParameters parameters_;
   std::vector<MapSegment> segments_;
   std::vector<Eigen::VectorXf> descriptors_;
   std::vector<bool> alive_;
@@ -67,5 +79,16 @@ std::vector<Eigen::Vector3f> subsamplePoints(const std::vector<Eigen::Vector3f>&
 void checkMapCompatible(const std::string& map_name, const TargetMap& map,
                         const std::string& descriptor, const std::string& fingerprint,
                         int dimension);
+
+// A recorded setting that the running configuration has otherwise; a key only one of them has
+// differs too (the missing side's value is "(none)"), so a map of an older build that did not
+// record a key is not taken for a match.
+struct MapParameterDifference {
+  std::string key, map_value, config_value;
+};
+std::vector<MapParameterDifference> mapParameterDifferences(const MapParameters& map,
+                                                            const MapParameters& config);
+// "<map_name>: <key>: the map was built with <map value>, the configuration has <config value>"
+std::string describeDifference(const std::string& map_name, const MapParameterDifference& d);
 
 }  // namespace semsegmap

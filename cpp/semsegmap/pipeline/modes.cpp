@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "semsegmap/pipeline/map_parameters.h"
+
 namespace semsegmap {
 
 namespace {
@@ -38,7 +40,9 @@ MappingSession::MappingSession(const PipelineConfig& config, const DatasetInfo& 
     : config_(config),
       pipeline_(config, info, poses, describer),
       builder_(descriptorName(describer->kind()), describer->fingerprint(), describer->dimension(),
-               config.target_map) {}
+               config.target_map) {
+  builder_.setParameters(mapParametersOf(config));
+}
 
 void MappingSession::add(const std::vector<Segment>& segments,
                          const std::vector<Eigen::VectorXf>& d) {

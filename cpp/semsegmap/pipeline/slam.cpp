@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "semsegmap/graph/pose_graph.h"
+#include "semsegmap/pipeline/map_parameters.h"
 
 namespace semsegmap {
 
@@ -47,6 +48,7 @@ class SlamSession {
     // The saved map: corrected centroids, duplicates of revisited places removed.
     const TargetMap& all = localizer_.map();
     TargetMapBuilder builder(all.descriptor, all.fingerprint, all.dimension(), config_.target_map);
+    builder.setParameters(mapParametersOf(config_));
     for (size_t s = 0; s < all.size(); ++s)
       builder.add(all.segments[s], all.descriptors.row(static_cast<Eigen::Index>(s)).transpose());
     run_.map = builder.build();

@@ -107,11 +107,16 @@ Trajectory makeTrajectory(const RoadNetwork& roads, Run run, const TrajectoryCon
   // Right-hand traffic: drive a quarter of the road width right of the centre line.
   const Polyline lane = roundCorners(offsetPolyline(center, -0.25 * roads.road_width_m, false),
                                      config.corner_cut_m, 0.25);
-  const double length = polylineLength(lane, false);
+  const double lap = polylineLength(lane, false);
+  if (config.laps < 1 || (config.laps > 1 && !loop))
+    throw std::invalid_argument("run " + runName(run) + ": laps=" + std::to_string(config.laps) +
+                                " (more than one lap needs a closed loop: S2 or S3)");
+  const double length = lap * config.laps;
   SeededRng rng(hashKeys(seed, 0x7a1));
   const double phase = rng.uniform(0.0, 2.0 * M_PI);
+  // The loop's lane ends where it starts, so a position past the lap wraps onto the next one.
   auto positionAt = [&](double s) {
-    const PolylinePoint p = pointAt(lane, s, false);
+    const PolylinePoint p = pointAt(lane, s <= lap ? s : std::fmod(s, lap), false);
     const Eigen::Vector2d left(-std::sin(p.heading), std::cos(p.heading));
     return (p.position + left * (config.lane_variation_m * std::sin(2.0 * M_PI * s / 70.0 + phase)))
         .eval();

@@ -26,6 +26,9 @@ struct TrajectoryConfig {
   double rate_hz = 5.0;
   double lane_variation_m = 0.3;  // slow weave inside the lane
   double corner_cut_m = 9.0;      // turns start this far before the intersection
+  // The loop driven this many times without stopping (S2 and S3 only, the closed loops): a long
+  // run for checking that memory stays flat over many kilometres.
+  int laps = 1;
 };
 
 // Odometry drift: a constant scale error and yaw bias per run (signs drawn from the seed), plus

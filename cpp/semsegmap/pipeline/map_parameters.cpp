@@ -1,0 +1,65 @@
+#include "semsegmap/pipeline/map_parameters.h"
+
+#include <charconv>
+#include <string>
+
+namespace semsegmap {
+
+namespace {
+
+// Shortest text that reads back as exactly `value`: equal text is equal settings.
+std::string exact(double value) {
+  char text[64];
+  const auto result = std::to_chars(text, text + sizeof(text), value);
+  return std::string(text, result.ptr);
+}
+std::string exact(bool value) {
+  return value ? "true" : "false";
+}
+std::string exact(size_t value) {
+  return std::to_string(value);
+}
+std::string exact(int value) {
+  return std::to_string(value);
+}
+std::string exact(uint32_t value) {
+  return std::to_string(value);
+}
+
+std::string dynamicRemovalName(DynamicRemoval r) {
+  return r == DynamicRemoval::kPoint ? "point" : "voxel";
+}
+
+}  // namespace
+
+MapParameters mapParametersOf(const PipelineConfig& config) {
+  const EnrichmentConfig& e = config.enrichment;
+  const LocalMapConfig& lm = config.local_map;
+  const SegmentationConfig& s = config.segmentation;
+  return {
+      {"enrichment.occlusion_radius_px", exact(e.occlusion_radius_px)},
+      {"enrichment.occlusion_tolerance_m", exact(e.occlusion_tolerance_m)},
+      {"enrichment.occlusion_tolerance_rel", exact(e.occlusion_tolerance_rel)},
+      {"local_map.voxel_size_m", exact(lm.voxel_size_m)},
+      {"local_map.radius_m", exact(lm.radius_m)},
+      {"local_map.min_points_per_voxel", exact(lm.min_points_per_voxel)},
+      {"local_map.remove_dynamic_classes", exact(lm.remove_dynamic_classes)},
+      {"local_map.dynamic_removal", dynamicRemovalName(lm.dynamic_removal)},
+      {"local_map.dynamic_vote_share", exact(lm.dynamic_vote_share)},
+      {"local_map.remove_ground_classes", exact(lm.remove_ground_classes)},
+      {"local_map.remove_unknown_class", exact(lm.remove_unknown_class)},
+      {"local_map.geometric_ground_removal", exact(lm.geometric_ground_removal)},
+      {"local_map.ground_cell_size_m", exact(lm.ground.cell_size_m)},
+      {"local_map.ground_neighbourhood_cells", exact(lm.ground.neighbourhood_cells)},
+      {"local_map.ground_height_above_m", exact(lm.ground.height_above_m)},
+      {"segmentation.d_segment_m", exact(s.d_segment_m)},
+      {"segmentation.hue_threshold", exact(s.hue_threshold)},
+      {"segmentation.hue_penalty", exact(s.hue_penalty)},
+      {"segmentation.class_penalty", exact(s.class_penalty)},
+      {"segmentation.min_segment_points", exact(s.min_segment_points)},
+      {"segmentation.max_segment_points", exact(s.max_segment_points)},
+      {"segmentation.observation_growth", exact(s.observation_growth)},
+  };
+}
+
+}  // namespace semsegmap
