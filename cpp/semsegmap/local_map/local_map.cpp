@@ -55,6 +55,10 @@ DynamicRemoval parseDynamicRemoval(const std::string& name) {
   throw std::invalid_argument("expected point or voxel, got '" + name + "'");
 }
 
+std::string dynamicRemovalName(DynamicRemoval removal) {
+  return removal == DynamicRemoval::kPoint ? "point" : "voxel";
+}
+
 Eigen::Vector3i LocalMap::voxelIndex(const Eigen::Vector3f& p) const {
   const float inv = static_cast<float>(1.0 / config_.voxel_size_m);
   return {static_cast<int>(std::floor(p.x() * inv)), static_cast<int>(std::floor(p.y() * inv)),

@@ -22,6 +22,7 @@ enum class DynamicRemoval {
   kVoxel,  // a voxel is dropped when its class votes say dynamic by majority
 };
 DynamicRemoval parseDynamicRemoval(const std::string& name);  // point | voxel
+std::string dynamicRemovalName(DynamicRemoval removal);       // its inverse
 
 struct LocalMapConfig {
   double voxel_size_m = 0.1;

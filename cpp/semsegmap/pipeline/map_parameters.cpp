@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <string>
+#include <type_traits>
 
 namespace semsegmap {
 
@@ -16,18 +17,9 @@ std::string exact(double value) {
 std::string exact(bool value) {
   return value ? "true" : "false";
 }
-std::string exact(size_t value) {
+template <typename Integer, typename = std::enable_if_t<std::is_integral_v<Integer>>>
+std::string exact(Integer value) {
   return std::to_string(value);
-}
-std::string exact(int value) {
-  return std::to_string(value);
-}
-std::string exact(uint32_t value) {
-  return std::to_string(value);
-}
-
-std::string dynamicRemovalName(DynamicRemoval r) {
-  return r == DynamicRemoval::kPoint ? "point" : "voxel";
 }
 
 }  // namespace
