@@ -6,14 +6,18 @@
 #include <limits>
 #include <set>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/binary_io.h"
 #include "semsegmap/core/class_table.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/core/pose.h"
 #include "semsegmap/core/random.h"
 #include "semsegmap/core/sensor_rig.h"
+#include "semsegmap/core/shown_text.h"
 #include "temp_dir.h"
 
 using namespace semsegmap;
@@ -38,6 +42,26 @@ TEST(ClassTable, RejectsDuplicateIds) {
 
 // The one layout of every JSON file: keys in the order they were set, a 2-space indent, a final
 // newline; quotes and backslashes escaped, so that what is written reads back unchanged.
+// The CLI's sink ends its progress line before a note; without a sink the line goes to stderr.
+TEST(Diagnostics, NotesAndWarningsGoToTheInstalledSinkAsWholeLines) {
+  std::vector<std::string> lines;
+  setMessageSink([&](const std::string& line) { lines.push_back(line); });
+  note("a rig read from defaults");
+  warn("a map built with other settings");
+  setMessageSink({});
+  testing::internal::CaptureStderr();
+  note("after the sink");
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "note: after the sink\n");
+  EXPECT_EQ(lines, (std::vector<std::string>{"note: a rig read from defaults",
+                                             "warning: a map built with other settings"}));
+}
+
+TEST(ShownText, NumbersReadAsAStreamPrintsThem) {
+  EXPECT_EQ(shownNumber(10.0), "10");
+  EXPECT_EQ(shownNumber(0.1), "0.1");
+  EXPECT_EQ(shownNumber(1e308), "1e+308");
+}
+
 TEST(Json, WritesOrderedIndentedEscapedText) {
   nlohmann::ordered_json j;
   j["name"] = "a \"quoted\" C:\\path";

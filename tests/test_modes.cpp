@@ -11,6 +11,7 @@
 #include <random>
 
 #include "build_options.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/datasets/lidar_odometry_source.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/graph/trajectory.h"
@@ -101,6 +102,42 @@ TEST(Modes, SummaryOfARunWithoutLocalizationsHasNoMeanError) {
   const std::string json = localizationSummaryJson(run, SummaryContext{});
   EXPECT_NE(json.find("\"mean_translation_error_m\": null"), std::string::npos) << json;
   EXPECT_NE(json.find("\"mean_rotation_error_deg\": null"), std::string::npos) << json;
+}
+
+// The session itself (not only the CLI) compares the map's recorded settings with its own: a
+// library user localizing against a map grown with another growing radius is refused, or warned
+// of each difference when they allow it.
+TEST(Modes, LocalizationRefusesAMapBuiltWithOtherSettingsUnlessAllowed) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  const auto oracle = std::make_shared<OracleDescriber>();
+  auto mapping = openDataset("sim:world=1,run=S2,preset=tiny,frames=10");
+  auto map = std::make_shared<TargetMap>(
+      runMapping(*mapping, semsegmapConfig(), PoseSource::kGroundTruth, oracle).map);
+  map->source = "built.map";
+  PipelineConfig other = semsegmapConfig();
+  other.segmentation.d_segment_m = 0.5;
+  auto query = openDataset("sim:world=1,run=S2,preset=tiny,frames=2");
+  try {
+    runLocalization(*query, other, map, oracle);
+    ADD_FAILURE() << "a map built with d_segment_m 0.3 was accepted with 0.5";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "built.map: segmentation.d_segment_m: the map was built with 0.3, the configuration "
+              "has 0.5 (rebuild the map with this configuration)");
+  }
+  std::vector<std::string> warnings;
+  setMessageSink([&](const std::string& line) { warnings.push_back(line); });
+  const LocalizationRun run =
+      runLocalization(*query, other, map, oracle, {}, MapSettingsCheck::kWarn);
+  setMessageSink({});
+  EXPECT_EQ(run.stats.frames, 2u);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_EQ(warnings[1],
+            "warning:   built.map: segmentation.d_segment_m: the map was built with 0.3, the "
+            "configuration has 0.5");
+  // A map that records no settings (made by hand) has nothing to compare.
+  map->parameters.clear();
+  EXPECT_NO_THROW(runLocalization(*query, other, map, oracle));
 }
 
 TEST(Modes, LocalizationRefusesAMapOfAnotherModel) {

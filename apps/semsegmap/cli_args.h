@@ -105,6 +105,5 @@ const CommandSpec& slamCommand();
 const CommandSpec& odometryCommand();
 const CommandSpec& trainCommand();
 const CommandSpec& viewCommand();  // a build with the viewer (SEMSEGMAP_WITH_VIEWER)
-const std::vector<const CommandSpec*>& evalCommands();  // "eval segmentation", ...
 
 }  // namespace semsegmap::app

@@ -8,27 +8,18 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "eval_args.h"
 #include "progress.h"
 #include "resources.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/eval/report.h"
-#include "semsegmap/eval/revisit_experiment.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
 
 namespace semsegmap::app {
 
 namespace {
-
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 // --query-runs: a list of runs, each one of S0..S3.
 std::vector<std::string> runList(const CliArgs& a, const std::string& name) {
@@ -64,18 +55,6 @@ std::string builtDescriptors() {
                                     DescriptorKind::kFpfh, DescriptorKind::kEigen})
     if (descriptorNotBuilt(kind).empty()) list += (list.empty() ? "" : ",") + descriptorName(kind);
   return list;
-}
-
-// The configurations compared: SemSegMap first, the SegMap baseline second.
-std::vector<NamedConfig> comparedConfigs(const CliArgs& a) {
-  std::vector<NamedConfig> configs;
-  // The default list names shipped configs; a list the user types names their own files.
-  for (const std::string& name : splitList(a.get("configs"))) {
-    const std::filesystem::path path =
-        a.has("configs") ? std::filesystem::path(name) : shippedFile(name);
-    configs.push_back(loadNamedConfig(path));
-  }
-  return configs;
 }
 
 SegmentationExperimentConfig segmentationConfig(const CliArgs& a) {
@@ -179,31 +158,6 @@ int runEvalPaper(const CliArgs& a) {
   return 0;
 }
 
-int runEvalRevisits(const CliArgs& a) {
-  RevisitExperimentConfig c;
-  try {
-    c.map_frames = parseFrameRanges(a.get("map-frames"), "option --map-frames");
-    c.query_frames = parseFrameRanges(a.get("query-frames"), "option --query-frames");
-    if (a.has("wake-up")) parseWakeUp(a.get("wake-up"), "option --wake-up", c);
-    c.check_ground_truth = a.has("check-ground-truth");
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  c.place_radius_m = a.getNumber("place-radius");
-  c.configs = comparedConfigs(a);
-  for (const NamedConfig& config : c.configs)
-    requireDescriberBuilt(config.config.descriptor, config.path.string());
-  // LiDAR odometry and a segmentation network come from the first configuration's sections.
-  const std::unique_ptr<FrameSource> source = openDatasetArg(a, c.configs.front().path);
-  StageProgress progress;
-  const std::filesystem::path out = a.get("out");
-  const RevisitExperiment e = evaluateRevisits(*source, c, out, std::ref(progress));
-  writeRevisitFiles(e, out);
-  std::cout << revisitTable(e) << "wrote " << (out / "revisits.json").string()
-            << ", revisits.png and one folder per configuration\n";
-  return 0;
-}
-
 // The options of the experiments, each declared once.
 const OptionSpec kWorldSeed{"world-seed", Value::kCount, "N", "1", "seed of the procedural world"};
 const OptionSpec kOut{"out", Value::kText, "DIR", "", "output folder", kRequired};
@@ -238,7 +192,7 @@ const OptionSpec kQueryOdometry{
 
 }  // namespace
 
-const std::vector<const CommandSpec*>& evalCommands() {
+const std::vector<const CommandSpec*>& simulatedEvalCommands() {
   static const CommandSpec segmentation{
       "eval segmentation",
       "segment consistency at revisits (convex hull IoU) -> segmentation.json",
@@ -259,29 +213,6 @@ const std::vector<const CommandSpec*>& evalCommands() {
        kQueryOdometry},
       "",
       runEvalLocalization};
-  static const CommandSpec revisits{
-      "eval revisits",
-      "maps some frames of a recording, localizes others against them -> revisits.json",
-      datasetOptions(
-          "a recording with ground-truth poses",
-          {{"map-frames", Value::kText, "A:B[,C:D]", "",
-            "frames the target map is built from (as the dataset lists them, from 0)", kRequired},
-           {"query-frames", Value::kText, "E:F[,G:H]", "",
-            "frames localized against it, on the dataset's odometry", kRequired},
-           {"configs", Value::kText, "A.yaml,B.yaml",
-            "config/semsegmap-kitti.yaml,config/segmap-kitti.yaml",
-            "the configurations compared (default: the shipped real-data ones)"},
-           {"place-radius", Value::kNumber, "M", "10",
-            "a query frame this close to a mapped frame is at a revisit"},
-           {"check-ground-truth", Value::kFlag, "", "",
-            "register each revisit scan to the mapped scans from its ground-truth pose: how far "
-            "the ground truth disagrees with the map's geometry, and the errors against the "
-            "registered poses"},
-           {"wake-up", Value::kText, "N[/EVERY]", "",
-            "the kidnapped robot: wake up at every EVERY-th query frame (default N) with an "
-            "empty local map and localize from the N frames from there"},
-           kOut}),
-      "", runEvalRevisits};
   static const CommandSpec paper{
       "eval paper",
       "the segmentation, descriptor and localization experiments, and report.md",
@@ -290,7 +221,7 @@ const std::vector<const CommandSpec*>& evalCommands() {
       "",
       runEvalPaper};
   static const std::vector<const CommandSpec*> all = {&segmentation, &descriptors, &localization,
-                                                      &revisits, &paper};
+                                                      &paper};
   return all;
 }
 

@@ -20,30 +20,18 @@ namespace semsegmap::app {
 
 namespace {
 
-// The map's recorded build settings against the configuration's, before the data is opened: a
-// map grown with another voxel size or growing radius holds segments the run never makes, and
-// localized nothing with exit 0. --allow-config-mismatch goes on, listing every difference.
-void checkMapSettings(const std::filesystem::path& map_path, const TargetMap& map,
-                      const PipelineConfig& config, bool allow_mismatch) {
-  const auto differences = mapParameterDifferences(map.parameters, mapParametersOf(config));
-  if (differences.empty()) return;
-  if (!allow_mismatch)
-    throw std::runtime_error(describeDifference(map_path.string(), differences.front()) +
-                             " (rebuild the map with this configuration, or give "
-                             "--allow-config-mismatch)");
-  std::cerr << "warning: --allow-config-mismatch: localizing against a map built with other "
-               "settings ("
-            << differences.size() << "):\n";
-  for (const MapParameterDifference& d : differences)
-    std::cerr << "warning:   " << describeDifference(map_path.string(), d) << "\n";
-}
-
 int runLocalize(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
   const std::filesystem::path map_path = a.get("map");
   const std::filesystem::path out = a.get("out");
   const auto map = std::make_shared<const TargetMap>(loadTargetMap(map_path));
-  checkMapSettings(map_path, *map, config, a.has("allow-config-mismatch"));
+  // The map's recorded build settings against the configuration's, before the data is opened;
+  // with --allow-config-mismatch the session warns of each difference instead.
+  const MapSettingsCheck settings =
+      a.has("allow-config-mismatch") ? MapSettingsCheck::kWarn : MapSettingsCheck::kRefuse;
+  if (settings == MapSettingsCheck::kRefuse)
+    checkMapParameters(map_path.string(), *map, config, settings,
+                       "rebuild the map with this configuration, or give --allow-config-mismatch");
   // The kind before the data; the model, which may follow from the data's modalities
   // (chooseDescriptor), is compared once the describer is made, still before any frame.
   const std::string kind = descriptorName(parseDescriptorKind(config.descriptor.kind));
@@ -60,7 +48,7 @@ int runLocalize(const CliArgs& a) {
   RunOptions options;
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
-  const LocalizationRun run = runLocalization(*source, config, map, describer, options);
+  const LocalizationRun run = runLocalization(*source, config, map, describer, options, settings);
 
   writeLocalizationsCsv(out / "localizations.csv", run);
   writeLocalizationDetails(out, run);  // matches.csv, trajectory.csv: for semsegmap view

@@ -3,10 +3,10 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <iostream>
 
 #include "cli_args.h"
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/io/map_file.h"
 #include "semsegmap/viz/scene_export.h"
 #include "viewer_asset.h"
@@ -57,9 +57,9 @@ uint64_t writeViewPage(const ViewSources& s, const std::filesystem::path& out) {
   if (s.slam) slam = readSlamFolder(*s.slam);
   if (s.segments) segments = readSegmentFolder(*s.segments);
   if (localization && !localization->has_matches)
-    std::cerr << "semsegmap view: note: " << localization->dir.string()
-              << " has no matches.csv (written by semsegmap localize since the viewer came): "
-                 "the page shows no matched segments\n";
+    note(localization->dir.string() +
+         " has no matches.csv (written by semsegmap localize since the viewer came): the page "
+         "shows no matched segments");
   viz::SceneInputs in;
   in.title = s.title.empty() ? titleOf(s, localization ? &*localization : nullptr) : s.title;
   in.map_name = s.map.filename().string();

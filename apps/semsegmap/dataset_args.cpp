@@ -1,9 +1,9 @@
 #include "dataset_args.h"
 
 #include <algorithm>
-#include <iostream>
 
 #include "resources.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
@@ -66,7 +66,7 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesys
 std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,
                                         const FrameSource& source) {
   const DescriptorChoice choice = chooseDescriptor(descriptor, inputModalitiesOf(source.info()));
-  if (!choice.note.empty()) std::cerr << "note: " << choice.note << "\n";
+  if (!choice.note.empty()) note(choice.note);
   return makeDescriber(choice.descriptor);
 }
 

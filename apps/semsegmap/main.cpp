@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "eval_args.h"
 #include "progress.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/io/run_output.h"
 
 #ifndef SEMSEGMAP_VERSION
@@ -41,7 +43,22 @@ const std::vector<const CommandSpec*>& commands() {
   return all;
 }
 
-// A command this build leaves out: its first word, the option that would bring it, and why.
+// The experiments: those on the simulator when the build has it, and `eval revisits` always.
+const std::vector<const CommandSpec*>& evalCommands() {
+  static const std::vector<const CommandSpec*> all = [] {
+    std::vector<const CommandSpec*> e;
+#if SEMSEGMAP_WITH_SIM
+    e = simulatedEvalCommands();
+#endif
+    // Before `eval paper`, which runs the others.
+    e.insert(e.end() - (e.empty() ? 0 : 1), &evalRevisitsCommand());
+    return e;
+  }();
+  return all;
+}
+
+// A command this build leaves out: its name (one word, or two after `eval`), the option that
+// would bring it, and why.
 struct AbsentCommand {
   std::string name, option, why;
 };
@@ -50,7 +67,8 @@ const std::vector<AbsentCommand>& absentCommands() {
   static const std::vector<AbsentCommand> absent = [] {
     std::vector<AbsentCommand> a;
     if (!SEMSEGMAP_WITH_SIM)
-      for (const char* name : {"simulate", "simulate-overview", "eval", "demo"})
+      for (const char* name : {"simulate", "simulate-overview", "eval segmentation",
+                               "eval descriptors", "eval localization", "eval paper", "demo"})
         a.push_back({name, "SEMSEGMAP_WITH_SIM",
                      "this build has no simulator (built without Embree, reconfigure with "
                      "-DSEMSEGMAP_WITH_SIM=ON)"});
@@ -81,24 +99,32 @@ std::string absentNote() {
 
 std::string overview() {
   std::vector<const CommandSpec*> listed = commands();
+  // The experiments before the demo (at the end in a build without it).
+  auto demo = listed.end();
 #if SEMSEGMAP_WITH_SIM
-  // The experiments before the demo.
-  listed.insert(std::find(listed.begin(), listed.end(), &demoCommand()), evalCommands().begin(),
-                evalCommands().end());
+  demo = std::find(listed.begin(), listed.end(), &demoCommand());
 #endif
+  listed.insert(demo, evalCommands().begin(), evalCommands().end());
   return "usage: semsegmap <command> [options]\n       semsegmap --version\n\ncommands:\n" +
          commandOverview(listed) + absentNote() + "\n" + kDatasetNotes +
          "\nrun 'semsegmap <command> --help' for a command's options and their defaults.\n";
 }
 
-#if SEMSEGMAP_WITH_SIM
 std::string evalOverview() {
   return "usage: semsegmap eval <experiment> [options]\n\nthe paper's experiments, SemSegMap "
          "against SegMap on the same frames\n\nexperiments:\n" +
          commandOverview(evalCommands()) +
          "\nrun 'semsegmap eval <experiment> --help' for an experiment's options.\n";
 }
-#endif
+
+// "segmentation, descriptors, localization, revisits or paper": the experiments of this build.
+std::string experimentList() {
+  std::string list;
+  const std::vector<const CommandSpec*>& e = evalCommands();
+  for (size_t i = 0; i < e.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == e.size() ? " or " : ", ") + e[i]->name.substr(5);
+  return list;
+}
 
 bool asksForHelp(const std::vector<std::string>& args) {
   for (const std::string& a : args)
@@ -115,20 +141,15 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
     return c;
   }
   if (args[0] != "eval") throw UsageError("unknown command '" + args[0] + "'");
-#if SEMSEGMAP_WITH_SIM
   *name = "eval";
-  const std::string expected = "segmentation, descriptors, localization, revisits or paper";
   if (args.size() < 2 || args[1].rfind("-", 0) == 0)
-    throw UsageError("eval needs an experiment: " + expected);
+    throw UsageError("eval needs an experiment: " + experimentList());
   for (const CommandSpec* c : evalCommands()) {
     if (c->name != "eval " + args[1]) continue;
     *name = c->name;
     return c;
   }
-  throw UsageError("unknown experiment '" + args[1] + "' (expected " + expected + ")");
-#else
-  throw std::logic_error("eval is not in this build; run() answers it");
-#endif
+  throw UsageError("unknown experiment '" + args[1] + "' (expected " + experimentList() + ")");
 }
 
 // What a command writes: --out and the options naming another file it writes; a DIR placeholder
@@ -153,17 +174,16 @@ int usageError(const std::string& name, const std::string& message) {
 }
 
 int run(const std::vector<std::string>& args) {
+  const std::string two_words = args.size() > 1 ? args[0] + " " + args[1] : args[0];
   for (const AbsentCommand& c : absentCommands()) {
-    if (args[0] != c.name) continue;
+    if (args[0] != c.name && two_words != c.name) continue;
     std::cerr << "semsegmap " << c.name << ": error: " << c.why << "\n";
     return 1;
   }
-#if SEMSEGMAP_WITH_SIM
   if (args[0] == "eval" && args.size() > 1 && (args[1] == "--help" || args[1] == "-h")) {
     std::cout << evalOverview();
     return 0;
   }
-#endif
   std::string name;
   try {
     const CommandSpec* command = findCommand(args, &name);
@@ -174,6 +194,12 @@ int run(const std::vector<std::string>& args) {
       return 0;
     }
     const CliArgs parsed(*command, rest);
+    // Notes and warnings of the library on a line of their own, never after a progress bar.
+    setMessageSink([](const std::string& line) {
+      endProgressLine();
+      std::fprintf(stderr, "%s\n", line.c_str());
+      std::fflush(stderr);
+    });
     RunOutputs outputs;  // a failed command leaves none of its outputs behind
     declareOutputs(parsed, outputs);
     const int code = command->run(parsed);

@@ -54,6 +54,7 @@ void bindTargetMap(py::module_& m) {
       m, "TargetMap", "What a robot localizes against (localize/target_map.h); read-only")
       .def_readonly("descriptor", &TargetMap::descriptor, "the describer's kind")
       .def_readonly("fingerprint", &TargetMap::fingerprint)
+      .def_readonly("source", &TargetMap::source, "the file it was loaded from, or ''")
       .def_property_readonly(
           "parameters", [](const TargetMap& map) { return parametersDict(map.parameters); },
           "dict of the settings the map was built with (pipeline/map_parameters.h), a copy")
@@ -193,8 +194,7 @@ void bindLocalize(py::module_& m) {
   m.def(
       "check_map_parameters",
       [](const TargetMap& map, const PipelineConfig& config, const std::string& name) {
-        const auto d = mapParameterDifferences(map.parameters, mapParametersOf(config));
-        if (!d.empty()) throw std::runtime_error(describeDifference(name, d.front()));
+        checkMapParameters(name, map, config, MapSettingsCheck::kRefuse);
       },
       py::arg("map"), py::arg("config"), py::arg("name") = "target map",
       "RuntimeError naming the first setting the map was built with otherwise than `config`");

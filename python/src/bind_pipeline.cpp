@@ -36,6 +36,10 @@ std::shared_ptr<Describer> required(std::shared_ptr<Describer> d, const char* wh
   return d;
 }
 
+MapSettingsCheck settingsCheck(bool allow_config_mismatch) {
+  return allow_config_mismatch ? MapSettingsCheck::kWarn : MapSettingsCheck::kRefuse;
+}
+
 // The command line's default: ground truth when the dataset has it, else odometry.
 PoseSource posesFor(const py::object& poses, const DatasetInfo& info) {
   if (poses.is_none())
@@ -311,14 +315,19 @@ void bindLocalization(py::module_& m) {
   py::class_<LocalizationSession>(m, "LocalizationSession",
                                   "Localizes a run frame by frame, on its odometry")
       .def(py::init([](const PipelineConfig& c, const DatasetInfo& info,
-                       std::shared_ptr<TargetMap> map, std::shared_ptr<Describer> d) {
+                       std::shared_ptr<TargetMap> map, std::shared_ptr<Describer> d,
+                       bool allow_config_mismatch) {
              d = required(std::move(d), "LocalizationSession");
              py::gil_scoped_release release;  // builds the map's descriptor index
              return std::make_unique<LocalizationSession>(
-                 c, info, std::shared_ptr<const TargetMap>(std::move(map)), std::move(d));
+                 c, info, std::shared_ptr<const TargetMap>(std::move(map)), std::move(d),
+                 settingsCheck(allow_config_mismatch));
            }),
            py::arg("config"), py::arg("info"), py::arg("map"), py::arg("describer"),
-           "RuntimeError when the map's descriptors are not the describer's")
+           py::arg("allow_config_mismatch") = false,
+           "RuntimeError when the map's descriptors are not the describer's, or when the map "
+           "was built with other settings than `config` (unless allow_config_mismatch: then "
+           "a warning on stderr for each)")
       .def(
           "process",
           [](LocalizationSession& s, const Frame& f) -> py::object {
@@ -337,16 +346,16 @@ void bindLocalization(py::module_& m) {
   m.def(
       "run_localization",
       [](FrameSource& source, const PipelineConfig& c, std::shared_ptr<TargetMap> map,
-         std::shared_ptr<Describer> d, size_t max_frames) {
+         std::shared_ptr<Describer> d, size_t max_frames, bool allow_config_mismatch) {
         d = required(std::move(d), "run_localization");
         RunOptions options;
         options.max_frames = max_frames;
         py::gil_scoped_release release;
         return runLocalization(source, c, std::shared_ptr<const TargetMap>(std::move(map)),
-                               std::move(d), options);
+                               std::move(d), options, settingsCheck(allow_config_mismatch));
       },
       py::arg("dataset"), py::arg("config"), py::arg("map"), py::arg("describer"),
-      py::arg("max_frames") = 0,
+      py::arg("max_frames") = 0, py::arg("allow_config_mismatch") = false,
       "Localizes the first max_frames frames (0: all), as `semsegmap localize` does");
 }
 

@@ -81,6 +81,18 @@ def test_localization_equals_the_command_lines(runs):
     assert run.trajectory_gt.shape == (QUERY_FRAMES, 4, 4) and run.distance_m > 0
 
 
+def test_a_session_refuses_a_map_built_with_other_settings(config, describer, runs):
+    ds = ssm.open_dataset(TINY_S1)
+    other = ssm.load_config(CONFIG)  # a copy: `config` is shared by the module's tests
+    other.segmentation.d_segment_m = config.segmentation.d_segment_m + 0.2
+    with pytest.raises(RuntimeError) as e:
+        ssm.LocalizationSession(other, ds.info, runs["built"].map, describer)
+    assert "segmentation.d_segment_m: the map was built with" in str(e.value)
+    allowed = ssm.LocalizationSession(other, ds.info, runs["built"].map, describer,
+                                      allow_config_mismatch=True)
+    assert allowed.run.localizations == []
+
+
 def test_a_revisit_range_localized_frame_by_frame(config, describer, runs):
     ds = ssm.open_dataset(TINY_S1)
     session = ssm.LocalizationSession(config, ds.info, runs["built"].map, describer)

@@ -86,7 +86,9 @@ def test_a_map_records_the_settings_it_was_built_with(tmp_dir):
     with pytest.raises(RuntimeError) as e:
         ssm.check_map_parameters(back, other, path)
     assert one_line(e.value) == (path + ": segmentation.d_segment_m: the map was built with "
-                                 "0.3, the configuration has 0.5")
+                                 "0.3, the configuration has 0.5 (rebuild the map with this "
+                                 "configuration)")
+    assert back.source == path
 
 
 def test_map_file_errors_name_the_file(tmp_dir):

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <string_view>
 
@@ -22,6 +23,14 @@ inline std::string shownText(std::string_view text, size_t max_chars = 80) {
   }
   if (text.size() > max_chars) out += "...";
   return out;
+}
+
+// A number as a stream prints it (6 significant digits: 10, 0.1, 1e+308): std::to_string's
+// fixed six decimals read badly in a message.
+inline std::string shownNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
 }
 
 }  // namespace semsegmap

@@ -1,10 +1,10 @@
 #include "semsegmap/datasets/open_dataset.h"
 
 #include <filesystem>
-#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/datasets/lidar_odometry_source.h"
 #include "semsegmap/datasets/pose_files.h"
 #include "semsegmap/datasets/semantic_sources.h"
@@ -157,7 +157,7 @@ std::unique_ptr<FrameSource> openSource(const std::string& spec, const DatasetOp
   if (!std::filesystem::is_directory(spec))
     throw std::runtime_error(spec + ": no such dataset directory");
   if (!std::filesystem::exists(std::filesystem::path(spec) / "meta.yaml")) {
-    std::cerr << "note: " << spec << " has no meta.yaml: reading it as folder:" << spec << "\n";
+    note(spec + " has no meta.yaml: reading it as folder:" + spec);
     return openFolder("folder:" + spec, spec, options);
   }
   return std::make_unique<DatasetReader>(spec, options.frames_to_check);

@@ -1,10 +1,10 @@
 #include "semsegmap/datasets/pose_files.h"
 
-#include <iostream>
 #include <optional>
 #include <stdexcept>
 #include <vector>
 
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/graph/trajectory.h"
 #include "semsegmap/io/kitti_calib.h"
 #include "semsegmap/io/trajectory_file.h"
@@ -23,8 +23,8 @@ void applyKittiCalib(const fs::path& poses_path, const fs::path& explicit_calib,
     const fs::path beside = poses_path.parent_path() / "calib.txt";
     if (!fs::exists(beside) || !KittiCalibFile(beside).has("Tr")) return;
     calib = beside;
-    std::cerr << "note: " << poses_path.string() << ": KITTI camera-0 poses, turned into LiDAR "
-              << "poses with Tr from " << calib.string() << " (--kitti-calib FILE to choose)\n";
+    note(poses_path.string() + ": KITTI camera-0 poses, turned into LiDAR poses with Tr from " +
+         calib.string() + " (--kitti-calib FILE to choose)");
   }
   const Pose Tr = KittiCalibFile(calib).transform3x4("Tr");
   std::vector<Pose> camera0;
@@ -71,8 +71,9 @@ class PosedSource : public FrameSource {
       throw std::runtime_error(named.string() + ": no scan of " + info_.name +
                                " lies within the poses' time span");
     if (kept_.size() < source_->size())
-      std::cerr << "note: " << source_->size() - kept_.size() << " of " << source_->size()
-                << " scans lie outside the poses' time span or in a gap and are left out\n";
+      note(std::to_string(source_->size() - kept_.size()) + " of " +
+           std::to_string(source_->size()) +
+           " scans lie outside the poses' time span or in a gap and are left out");
     info_.has_odometry |= !odom.empty();
     info_.has_ground_truth_poses |= !gt.empty();
   }

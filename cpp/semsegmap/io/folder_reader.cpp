@@ -4,11 +4,12 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
-#include <iostream>
 #include <map>
 #include <sstream>
 #include <stdexcept>
 
+#include "semsegmap/core/diagnostics.h"
+#include "semsegmap/core/shown_text.h"
 #include "semsegmap/core/time_association.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/kitti_calib.h"
@@ -146,8 +147,8 @@ FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : 
   } else {
     rig.rig.lidar.hfov_deg = 360.0;
     rig.rig.rate_hz = 10.0;  // as a rig file without rate_hz
-    std::cerr << "note: " << dir_.string() << " has no rig file (rig.yaml, or --rig FILE): "
-              << "LiDAR only at " << rig.rig.rate_hz << " Hz, the base frame is the LiDAR\n";
+    note(dir_.string() + " has no rig file (rig.yaml, or --rig FILE): LiDAR only at " +
+         shownNumber(rig.rig.rate_hz) + " Hz, the base frame is the LiDAR");
   }
   info_.name = !rig.name.empty() ? rig.name : "folder:" + fs::absolute(dir_).filename().string();
   info_.rig = rig.rig;
@@ -167,9 +168,9 @@ FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : 
   } else {
     for (size_t i = 0; i < scans_.size(); ++i) times_.push_back(i / info_.rig.rate_hz);
     if (scans_.size() > 1)
-      std::cerr << "note: " << lidar_dir.string() << ": the scans' names are no times and there "
-                << "is no times file: scans are taken " << 1.0 / info_.rig.rate_hz
-                << " s apart in name order\n";
+      note(lidar_dir.string() +
+           ": the scans' names are no times and there is no times file: scans are taken " +
+           shownNumber(1.0 / info_.rig.rate_hz) + " s apart in name order");
   }
   if (!std::is_sorted(times_.begin(), times_.end()))
     throw std::runtime_error(lidar_dir.string() + ": the scan times do not increase in name order");
@@ -219,9 +220,9 @@ void FolderReader::pairPictures(size_t camera, const fs::path& folder) {
   }
   const size_t unpaired = static_cast<size_t>(std::count(paired.begin(), paired.end(), fs::path()));
   if (unpaired > 0)
-    std::cerr << "note: camera '" << cam.name << "': " << unpaired << " of " << scans_.size()
-              << " scans have no picture within " << tolerance_s_
-              << " s; their points get no colour from it\n";
+    note("camera '" + cam.name + "': " + std::to_string(unpaired) + " of " +
+         std::to_string(scans_.size()) + " scans have no picture within " +
+         shownNumber(tolerance_s_) + " s; their points get no colour from it");
   if (unpaired == scans_.size())
     throw std::runtime_error(folder.string() + ": no picture of camera '" + cam.name +
                              "' lies within " + std::to_string(tolerance_s_) + " s of a scan");

@@ -164,6 +164,7 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
     }
   r.expectEnd("the segments");
   if (const std::string bad = firstNonFinite(map); !bad.empty()) r.fail(bad);
+  map.source = path.string();
   return map;
 }
 

@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iostream>
 #include <map>
 #include <stdexcept>
 
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/core/time_association.h"
 #include "semsegmap/graph/trajectory.h"
 #include "semsegmap/io/ros_decode.h"
@@ -149,7 +149,7 @@ void RosbagReader::fail(const std::string& what) const {
 }
 
 void RosbagReader::note(const std::string& what) const {
-  std::cerr << "note: " << path_.string() << ": " << what << "\n";
+  semsegmap::note(path_.string() + ": " + what);
 }
 
 std::vector<std::string> RosbagReader::cameraTopics() const {

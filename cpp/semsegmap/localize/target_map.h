@@ -34,6 +34,7 @@ struct TargetMap {
   std::vector<MapSegment> segments;
   Eigen::MatrixXf descriptors;  // one row per segment
   MapParameters parameters;     // what it was built with; empty for a map made by hand
+  std::string source;  // the file it was loaded from, for messages; empty for a map in memory
 
   size_t size() const { return segments.size(); }
   int dimension() const { return static_cast<int>(descriptors.cols()); }

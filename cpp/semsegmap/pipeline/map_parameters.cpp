@@ -1,8 +1,11 @@
 #include "semsegmap/pipeline/map_parameters.h"
 
 #include <charconv>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
+
+#include "semsegmap/core/diagnostics.h"
 
 namespace semsegmap {
 
@@ -52,6 +55,20 @@ MapParameters mapParametersOf(const PipelineConfig& config) {
       {"segmentation.max_segment_points", exact(s.max_segment_points)},
       {"segmentation.observation_growth", exact(s.observation_growth)},
   };
+}
+
+void checkMapParameters(const std::string& map_name, const TargetMap& map,
+                        const PipelineConfig& config, MapSettingsCheck check,
+                        const std::string& remedy) {
+  if (map.parameters.empty()) return;
+  const auto differences = mapParameterDifferences(map.parameters, mapParametersOf(config));
+  if (differences.empty()) return;
+  if (check == MapSettingsCheck::kRefuse)
+    throw std::runtime_error(describeDifference(map_name, differences.front()) + " (" + remedy +
+                             ")");
+  warn("localizing against a map built with other settings (" + std::to_string(differences.size()) +
+       " differ):");
+  for (const MapParameterDifference& d : differences) warn("  " + describeDifference(map_name, d));
 }
 
 }  // namespace semsegmap

@@ -11,4 +11,16 @@ namespace semsegmap {
 
 MapParameters mapParametersOf(const PipelineConfig& config);
 
+// What a difference between a map's recorded settings and the configuration's does: refuse (a
+// map grown with another voxel size or growing radius holds segments the run never makes, and
+// localized nothing with exit 0), or go on with a warning for each difference.
+enum class MapSettingsCheck { kRefuse, kWarn };
+
+// Throws std::runtime_error naming `map_name`, the first differing key and both values, and
+// `remedy`; with kWarn, warns (core/diagnostics.h) once per difference. A map that records no
+// settings (made by hand, not by MappingSession) has nothing to compare and passes.
+void checkMapParameters(const std::string& map_name, const TargetMap& map,
+                        const PipelineConfig& config, MapSettingsCheck check,
+                        const std::string& remedy = "rebuild the map with this configuration");
+
 }  // namespace semsegmap

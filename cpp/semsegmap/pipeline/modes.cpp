@@ -78,11 +78,14 @@ MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSou
 namespace {
 std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map,
                                             const Describer& describer,
-                                            const LocalizationConfig& config) {
+                                            const PipelineConfig& config,
+                                            MapSettingsCheck settings) {
   if (!map) throw std::invalid_argument("no target map");
-  checkMapCompatible("the target map", *map, descriptorName(describer.kind()),
-                     describer.fingerprint(), describer.dimension());
-  if (config.refinement.enabled && !hasSegmentPoints(*map))
+  const std::string name = map->source.empty() ? "the target map" : map->source;
+  checkMapCompatible(name, *map, descriptorName(describer.kind()), describer.fingerprint(),
+                     describer.dimension());
+  checkMapParameters(name, *map, config, settings);
+  if (config.localization.refinement.enabled && !hasSegmentPoints(*map))
     throw std::invalid_argument(
         "the target map stores no segment points, which localization.refinement needs: build "
         "it with target_map.max_points_per_segment (map --points N) or turn refinement off");
@@ -92,9 +95,10 @@ std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map
 
 LocalizationSession::LocalizationSession(const PipelineConfig& config, const DatasetInfo& info,
                                          std::shared_ptr<const TargetMap> map,
-                                         std::shared_ptr<Describer> describer)
+                                         std::shared_ptr<Describer> describer,
+                                         MapSettingsCheck settings)
     : config_(config),
-      localizer_(checkedMap(std::move(map), *describer, config.localization),
+      localizer_(checkedMap(std::move(map), *describer, config, settings),
                  config.localization.localizer),
       pipeline_(config, info, PoseSource::kOdometry, std::move(describer)) {}
 
@@ -158,8 +162,10 @@ void LocalizationSession::record(const Frame& frame, const FrameResult& r, const
 
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
                                 std::shared_ptr<const TargetMap> map,
-                                std::shared_ptr<Describer> describer, const RunOptions& options) {
-  LocalizationSession session(config, source.info(), std::move(map), std::move(describer));
+                                std::shared_ptr<Describer> describer, const RunOptions& options,
+                                MapSettingsCheck settings) {
+  LocalizationSession session(config, source.info(), std::move(map), std::move(describer),
+                              settings);
   feed(source, options, session);
   return session.take();
 }

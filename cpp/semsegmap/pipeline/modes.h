@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/pipeline.h"
 
 namespace semsegmap {
@@ -81,12 +82,14 @@ struct LocalizationRun {
 };
 
 // Localizes the local segment map (built on odometry, as a robot would) against `map` every
-// config.localization.every_n_frames frames; checks the describer against the map first (kind,
-// dimension and model).
+// config.localization.every_n_frames frames. Checks first that the describer's descriptors are
+// the map's (kind, dimension and model) and that the map was built with the configuration's
+// enrichment, local-map and segmentation settings (`settings`: refuse or warn).
 class LocalizationSession {
  public:
   LocalizationSession(const PipelineConfig& config, const DatasetInfo& info,
-                      std::shared_ptr<const TargetMap> map, std::shared_ptr<Describer> describer);
+                      std::shared_ptr<const TargetMap> map, std::shared_ptr<Describer> describer,
+                      MapSettingsCheck settings = MapSettingsCheck::kRefuse);
   void process(const Frame& frame);
   const LocalizationRun& run() const { return run_; }
   LocalizationRun take() { return std::move(run_); }
@@ -106,7 +109,8 @@ class LocalizationSession {
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
                                 std::shared_ptr<const TargetMap> map,
                                 std::shared_ptr<Describer> describer,
-                                const RunOptions& options = {});
+                                const RunOptions& options = {},
+                                MapSettingsCheck settings = MapSettingsCheck::kRefuse);
 
 struct LocalizationSummary {
   size_t localizations = 0, below_1m = 0, below_5m = 0;

@@ -1,0 +1,23 @@
+// What the eval commands share: comma lists and the configurations they compare.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cli_args.h"
+#include "semsegmap/eval/experiment.h"
+
+namespace semsegmap::app {
+
+std::vector<std::string> splitList(const std::string& s);
+
+// --configs: SemSegMap first, the SegMap baseline second. The default list names shipped
+// configs; a list the user types names their own files.
+std::vector<NamedConfig> comparedConfigs(const CliArgs& a);
+
+// The experiments on the simulator (eval segmentation, descriptors, localization, paper): only
+// in a build with it (cmd_eval.cpp). `eval revisits` runs on any recording (cmd_eval_revisits).
+const std::vector<const CommandSpec*>& simulatedEvalCommands();
+const CommandSpec& evalRevisitsCommand();
+
+}  // namespace semsegmap::app
