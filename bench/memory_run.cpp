@@ -43,11 +43,12 @@ double residentMegabytes() {
   return static_cast<double>(pages_resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1e6;
 }
 
-// The largest resident set size of the process so far (getrusage: kilobytes on Linux).
+// The largest resident set size of the process so far (getrusage: KiB on Linux), in the MB
+// (10^6 bytes) of residentMegabytes.
 double peakResidentMegabytes() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1e3;
+  return static_cast<double>(usage.ru_maxrss) * 1024.0 / 1e6;
 }
 
 struct Sample {

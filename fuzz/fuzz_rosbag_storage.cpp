@@ -1,5 +1,5 @@
 // Bag storages (io/rosbag_storage.h): an input starting "#ROSBAG" as a ROS 1 .bag, any other
-// as an MCAP file (the SQLite of .db3 bags is SQLite's own, fuzzed by its authors): its topics,
+// as an MCAP file (.db3 bags: fuzz_rosbag_sqlite): its topics,
 // the index of every topic's messages and the first few messages' bytes.
 #include <algorithm>
 

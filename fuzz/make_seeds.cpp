@@ -131,9 +131,16 @@ void datasetSeeds(const fs::path& dir, const fs::path& scratch) {
       writer.write(f);
     }
   }
-  writeText(dir / "three_frames", readText(scratch / "dataset/meta.yaml") +
-                                      "\n--- frames.csv ---\n" +
-                                      readText(scratch / "dataset/frames.csv"));
+  const std::string head = readText(scratch / "dataset/meta.yaml") + "\n--- frames.csv ---\n" +
+                           readText(scratch / "dataset/frames.csv");
+  writeText(dir / "three_frames", head);
+  // With the files of the frames: frame 0's scan (and its labels, for meta.yaml to declare).
+  const std::string scan = readText(scratch / "dataset/lidar" / frameFileName(0, "bin"));
+  writeText(dir / "three_frames_with_scans", head + "\n--- lidar ---\n" + scan);
+  const fs::path labels = scratch / "dataset/lidar_gt" / frameFileName(0, "bin");
+  if (fs::exists(labels))
+    writeText(dir / "three_frames_with_labels",
+              head + "\n--- lidar ---\n" + scan + "\n--- labels ---\n" + readText(labels));
 }
 
 void kittiSeeds(const fs::path& calib_dir, const fs::path& scan_dir) {
@@ -266,6 +273,32 @@ void bagStorageSeeds(const fs::path& dir) {
   writeText(dir / "empty.bag", "#ROSBAG V2.0\n");
 }
 
+// fuzz_rosbag_sqlite's rows (its header says the layout): a cloud topic with two messages, as
+// a .db3 alone and in a bag folder with its metadata.yaml.
+std::string hex(const std::string& bytes) {
+  static const char* digits = "0123456789abcdef";
+  std::string out;
+  for (const char c : bytes) {
+    const auto b = static_cast<unsigned char>(c);
+    out += digits[b >> 4];
+    out += digits[b & 15];
+  }
+  return out;
+}
+
+void sqliteBagSeeds(const fs::path& dir) {
+  const std::string cloud = hex(toCdr(someCloud()));
+  const std::string rows =
+      "--8<--\ntopics|i1|t/points|tsensor_msgs/msg/PointCloud2|tcdr\n"
+      "messages|i1|i1|i12500000000|x" +
+      cloud + "\n" + "messages|i2|i1|i12600000000|x" + cloud + "\n";
+  writeText(dir / "db3_only", rows);
+  writeText(dir / "with_metadata",
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n"
+            "  relative_file_paths:\n    - bag_0.db3\n  compression_format: \"\"\n" +
+                rows);
+}
+
 }  // namespace
 #endif
 
@@ -311,6 +344,7 @@ int main(int argc, char** argv) {
 #if SEMSEGMAP_WITH_ROS
     rosMessageSeeds(out / "ros_messages");
     bagStorageSeeds(out / "rosbag_storage");
+    sqliteBagSeeds(out / "rosbag_sqlite");
 #endif
     copyTextSeeds(out, source);
     labelSetSeeds(out / "class_map", scratch);

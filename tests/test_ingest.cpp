@@ -3,6 +3,7 @@
 // ../shared/data (KITTI 00 as PCD, the PJLab rig) are read when present.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -622,16 +623,31 @@ TEST(FuzzRegressions, PointCloudFiles) {
   }
 }
 
-// The harness's input is meta.yaml, a line "--- frames.csv ---", then frames.csv.
+// The harness's input is meta.yaml, a line "--- frames.csv ---", frames.csv, and optionally
+// "--- lidar ---" and "--- labels ---" with the files of frames 0-2 (fuzz/fuzz_dataset_dir.cpp).
 TEST(FuzzRegressions, DatasetFolders) {
-  TempDir tmp;
+  const auto split = [](const std::string& text, const std::string& separator) {
+    const size_t at = text.find(separator);
+    if (at == std::string::npos) return std::pair<std::string, std::string>{text, ""};
+    return std::pair<std::string, std::string>{text.substr(0, at),
+                                               text.substr(at + separator.size())};
+  };
   for (const auto& [name, bytes] : semsegmap::test_support::fuzzRegressions("dataset_dir")) {
-    const std::string separator = "\n--- frames.csv ---\n";
-    const size_t at = bytes.find(separator);
-    std::ofstream(tmp.path() / "meta.yaml", std::ios::binary) << bytes.substr(0, at);
-    std::ofstream(tmp.path() / "frames.csv", std::ios::binary)
-        << (at == std::string::npos ? "" : bytes.substr(at + separator.size()));
-    semsegmap::test_support::expectCleanRefusal(name, tmp.path().string(),
-                                                [&] { DatasetReader reader(tmp.path()); });
+    TempDir tmp;
+    const auto [meta, rest] = split(bytes, "\n--- frames.csv ---\n");
+    const auto [frames, files] = split(rest, "\n--- lidar ---\n");
+    const auto [scan, labels] = split(files, "\n--- labels ---\n");
+    std::ofstream(tmp.path() / "meta.yaml", std::ios::binary) << meta;
+    std::ofstream(tmp.path() / "frames.csv", std::ios::binary) << frames;
+    for (const auto& [folder, content] : {std::pair{"lidar", scan}, std::pair{"lidar_gt", labels}})
+      if (!content.empty()) {
+        std::filesystem::create_directories(tmp.path() / folder);
+        for (size_t i = 0; i < 3; ++i)
+          std::ofstream(tmp.path() / folder / frameFileName(i, "bin"), std::ios::binary) << content;
+      }
+    semsegmap::test_support::expectCleanRefusal(name, tmp.path().string(), [&] {
+      DatasetReader reader(tmp.path(), 3);
+      for (size_t i = 0; i < std::min<size_t>(reader.size(), 3); ++i) (void)reader.frame(i);
+    });
   }
 }

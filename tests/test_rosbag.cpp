@@ -29,6 +29,7 @@
 
 #include "error_text.h"
 #include "fuzz_regressions.h"
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/kitti_raw_reader.h"
@@ -1403,6 +1404,64 @@ TEST(FuzzRegressions, RosMessages) {
         << name;
   }
 }
+
+#if SEMSEGMAP_WITH_ROS1
+// Where the data of a bag's first chunk starts: the records walked by their lengths (uint32
+// header length, header, uint32 data length, data) to the first whose header holds op=0x05.
+size_t firstChunkData(const std::string& bag) {
+  const auto u32 = [&](size_t at) {
+    uint32_t v = 0;
+    std::memcpy(&v, bag.data() + at, 4);
+    return v;
+  };
+  for (size_t at = 13; at + 8 <= bag.size();) {
+    const uint32_t header = u32(at), data = u32(at + 4 + header);
+    if (bag.substr(at + 4, header).find(std::string("op=\x05", 4)) != std::string::npos)
+      return at + 8 + header;
+    at += 8 + header + data;
+  }
+  return std::string::npos;
+}
+
+// rosbag allocates a chunk's buffer by the size its header states, and reads the records in it
+// by their lengths: both are checked when the bag opens, with one line naming the bag.
+TEST(Ros1Chunks, ACorruptChunkSizeOrInnerRecordIsRefusedWhenTheBagOpens) {
+  TempDir dir;
+  std::vector<BagMessage> messages;
+  for (double t = kEpoch; t < kEpoch + 0.35; t += 0.1)
+    messages.push_back(
+        {"/odom", t, rm::Odometry{{t, "odom"}, "base_link", transformOf(Pose::Identity())}});
+  const fs::path plain = dir.path() / "plain.bag", packed = dir.path() / "packed.bag";
+  writeRos1(plain, messages);
+  writeRos1(packed, messages, rosbag::compression::BZ2);
+  for (const fs::path& good : {plain, packed}) EXPECT_NO_THROW(rm::openBagStorage(good));
+  const auto refusal = [&](const std::string& bytes) {
+    const fs::path bad = dir.path() / "bad.bag";
+    std::ofstream(bad, std::ios::binary) << bytes;
+    const std::string e = errorOf([&] { rm::openBagStorage(bad); });
+    EXPECT_EQ(e.rfind(bad.string() + ": truncated or corrupt ROS 1 bag (the record at byte ", 0),
+              0u)
+        << e;
+    EXPECT_ONE_LINE(e);
+    return e;
+  };
+  const auto withSize = [](std::string bytes, uint32_t size) {
+    const size_t at = bytes.find("size=");
+    std::memcpy(bytes.data() + at + 5, &size, 4);
+    return bytes;
+  };
+  const std::string plain_bytes = semsegmap::readFileBytes(plain),
+                    packed_bytes = semsegmap::readFileBytes(packed);
+  EXPECT_MENTIONS(refusal(withSize(plain_bytes, 0xFFFFFF00u)), "says it holds 4294967040");
+  EXPECT_MENTIONS(refusal(withSize(packed_bytes, 0x7FFFFFFFu)), "says it unpacks to 2147483647");
+  std::string inner = plain_bytes;
+  const size_t data = firstChunkData(inner);
+  ASSERT_NE(data, std::string::npos);
+  const uint32_t huge = 0x7FFFFFF0u;
+  std::memcpy(inner.data() + data, &huge, 4);
+  EXPECT_MENTIONS(refusal(inner), "ends past the end of its chunk");
+}
+#endif
 
 // What the storage harness found: ROS 1 bags whose record lengths rosbag allocated as read.
 TEST(FuzzRegressions, BagStorages) {

@@ -7,6 +7,7 @@
 #include <rosbag/query.h>
 #include <rosbag/view.h>
 
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <stdexcept>
@@ -19,33 +20,114 @@ namespace {
 namespace fs = std::filesystem;
 
 // rosbag allocates each record's header and data lengths as it reads them (a corrupt length is
-// 4 GB), so the records' lengths are walked first: "#ROSBAG V2.0", then records of uint32 header
-// length, header, uint32 data length, data, each of which must end inside the file.
-void checkRecordLengths(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  const uint64_t size = fs::file_size(file);
-  std::string version(13, '\0');
-  if (!in.read(version.data(), 13) || version != "#ROSBAG V2.0\n")
-    throw std::runtime_error(file.string() + ": not a ROS 1 bag of format 2.0");
-  for (uint64_t at = 13; at < size;) {
-    const uint64_t record = at;
-    for (int part = 0; part < 2; ++part) {  // the header, then the data
-      uint32_t length = 0;
-      if (size - at < 4 || !in.read(reinterpret_cast<char*>(&length), 4) || length > size - at - 4)
-        throw std::runtime_error(file.string() +
-                                 ": truncated or corrupt ROS 1 bag (the record at " + "byte " +
-                                 std::to_string(record) + " ends past the end; an " +
-                                 "interrupted recording? `rosbag reindex` repairs it)");
-      at += 4 + length;
-      in.seekg(static_cast<std::streamoff>(at));
+// 4 GB), and a chunk's buffer by the uncompressed size its header states, so the records are
+// walked first: "#ROSBAG V2.0", then records of uint32 header length, header (fields of uint32
+// length and "name=value"), uint32 data length, data, each of which must end inside the file. A
+// chunk's data is itself such records: walked too when it is uncompressed; a compressed one
+// (bz2, lz4) is only bounded by its size, as checking its records would mean unpacking it.
+class RecordWalk {
+ public:
+  explicit RecordWalk(fs::path file) : file_(std::move(file)), in_(file_, std::ios::binary) {}
+
+  void walkBag() {
+    const uint64_t size = fs::file_size(file_);
+    std::string version(13, '\0');
+    if (!in_.read(version.data(), 13) || version != "#ROSBAG V2.0\n")
+      throw std::runtime_error(file_.string() + ": not a ROS 1 bag of format 2.0");
+    walk(13, size, false);
+  }
+
+ private:
+  struct Header {
+    int op = -1;
+    std::string compression;
+    int64_t size = -1;  // a chunk's uncompressed size
+  };
+  // A real record header holds a few short fields; a longer one is corrupt.
+  static constexpr uint32_t kMaxHeaderBytes = 1 << 20;
+  // A chunk unpacks to at most 1 GiB (rosbag writes 768 KiB chunks, larger only for one large
+  // message); a compressed one beyond 64 MiB to at most 1000 times its size (bz2 of LiDAR and
+  // camera data gains less than 10 times; below 64 MiB any ratio, as of a chunk of zeros).
+  static constexpr uint64_t kMaxChunkBytes = uint64_t{1} << 30;
+  static constexpr uint64_t kAnyRatioBytes = uint64_t{64} << 20;
+
+  void walk(uint64_t at, uint64_t end, bool in_chunk) {
+    while (at < end) {
+      const uint64_t record = at;
+      const uint32_t header_length = length(at, end, record, in_chunk);
+      if (header_length > kMaxHeaderBytes)
+        corrupt(record, "has a header of " + std::to_string(header_length) + " bytes");
+      std::string bytes(header_length, '\0');
+      in_.read(bytes.data(), header_length);
+      const Header header = parse(bytes);
+      at += 4 + header_length;
+      const uint32_t data_length = length(at, end, record, in_chunk);
+      if (!in_chunk && header.op == 0x05) checkChunk(record, header, at + 4, data_length);
+      at += 4 + data_length;
     }
   }
-}
+
+  // The uint32 at `at`, which must be followed by that many bytes before `end`.
+  uint32_t length(uint64_t at, uint64_t end, uint64_t record, bool in_chunk) {
+    uint32_t value = 0;
+    in_.seekg(static_cast<std::streamoff>(at));
+    if (end - at < 4 || !in_.read(reinterpret_cast<char*>(&value), 4) || value > end - at - 4)
+      corrupt(record, in_chunk ? "ends past the end of its chunk" : "ends past the end");
+    return value;
+  }
+
+  void checkChunk(uint64_t record, const Header& h, uint64_t data, uint32_t data_length) {
+    if (h.size < 0) corrupt(record, "is a chunk that does not say its size");
+    const auto size = static_cast<uint64_t>(h.size);
+    if (h.compression == "none") {
+      if (size != data_length)
+        corrupt(record, "is an uncompressed chunk of " + std::to_string(data_length) +
+                            " bytes that says it holds " + std::to_string(size));
+      walk(data, data + data_length, true);
+    } else if (size > kMaxChunkBytes ||
+               (size > kAnyRatioBytes && size > 1000 * uint64_t{data_length})) {
+      corrupt(record, "is a chunk of " + std::to_string(data_length) +
+                          " bytes that says it unpacks to " + std::to_string(size));
+    }
+  }
+
+  // The fields of a record header; the ones the checks need are kept.
+  Header parse(const std::string& bytes) const {
+    Header h;
+    for (size_t at = 0; at + 4 <= bytes.size();) {
+      uint32_t n = 0;
+      std::memcpy(&n, bytes.data() + at, 4);
+      if (n > bytes.size() - at - 4) break;  // rosbag refuses such a header itself
+      const std::string field = bytes.substr(at + 4, n);
+      at += 4 + n;
+      const size_t eq = field.find('=');
+      if (eq == std::string::npos) continue;
+      const std::string name = field.substr(0, eq), value = field.substr(eq + 1);
+      if (name == "op" && value.size() == 1) h.op = static_cast<unsigned char>(value[0]);
+      if (name == "compression") h.compression = value;
+      if (name == "size" && value.size() == 4) {
+        uint32_t size = 0;
+        std::memcpy(&size, value.data(), 4);
+        h.size = size;
+      }
+    }
+    return h;
+  }
+
+  [[noreturn]] void corrupt(uint64_t record, const std::string& what) const {
+    throw std::runtime_error(file_.string() + ": truncated or corrupt ROS 1 bag (the record at " +
+                             "byte " + std::to_string(record) + " " + what +
+                             "; an interrupted recording? `rosbag reindex` repairs it)");
+  }
+
+  fs::path file_;
+  std::ifstream in_;
+};
 
 class Ros1Bag : public BagStorage {
  public:
   explicit Ros1Bag(const fs::path& file) : path_(file) {
-    checkRecordLengths(file);
+    RecordWalk(file).walkBag();
     guard("not a readable ROS 1 bag", [&] {
       bag_.open(file.string(), rosbag::bagmode::Read);
       rosbag::View all(bag_);
