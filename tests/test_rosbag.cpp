@@ -39,6 +39,7 @@
 #include "semsegmap/io/ros_tf.h"
 #include "semsegmap/io/rosbag_reader.h"
 #include "semsegmap/io/rosbag_storage.h"
+#include "sqlite_bag_rows.h"
 #include "temp_dir.h"
 
 namespace {
@@ -1471,6 +1472,27 @@ TEST(FuzzRegressions, BagStorages) {
     std::ofstream(bag, std::ios::binary) << bytes;
     semsegmap::test_support::expectCleanRefusal(name, bag.string(), [&] {
       const auto storage = rm::openBagStorage(bag);
+      for (const rm::BagTopic& topic : storage->topics()) storage->messages(topic.name);
+    });
+  }
+}
+
+// What the .db3 harness found (fuzz/fuzz_rosbag_sqlite.cpp builds the bag from the input's
+// metadata.yaml and table rows, with the same code as here): a metadata.yaml that lists an
+// absolute path, whose error named that path and not the bag; a YAML error of two lines.
+TEST(FuzzRegressions, SqliteBags) {
+  for (const auto& [name, bytes] : semsegmap::test_support::fuzzRegressions("rosbag_sqlite")) {
+    TempDir dir;
+    const std::string separator = "--8<--\n";
+    const size_t at = bytes.find(separator);
+    const std::string metadata = bytes.substr(0, at);
+    const std::string rows = at == std::string::npos ? "" : bytes.substr(at + separator.size());
+    const fs::path bag = dir.path() / "bag";
+    fs::create_directories(bag);
+    semsegmap::fuzz::writeBagDatabase(bag / "bag_0.db3", rows);
+    if (!metadata.empty()) std::ofstream(bag / "metadata.yaml", std::ios::binary) << metadata;
+    semsegmap::test_support::expectNoFinding(name, bag.string(), [&] {
+      const auto storage = rm::openBagStorage(metadata.empty() ? bag / "bag_0.db3" : bag);
       for (const rm::BagTopic& topic : storage->topics()) storage->messages(topic.name);
     });
   }

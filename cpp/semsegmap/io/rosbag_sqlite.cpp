@@ -8,6 +8,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "semsegmap/core/shown_text.h"
 #include "semsegmap/io/rosbag_storage.h"
 
 namespace semsegmap::rosmsg {
@@ -15,8 +16,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The file's name as read (from metadata.yaml, it may hold any byte) on one line.
 [[noreturn]] void fail(const fs::path& file, const std::string& what) {
-  throw std::runtime_error(file.string() + ": " + what);
+  throw std::runtime_error(shownText(file.string(), 4096) + ": " + what);
 }
 
 struct DbCloser {
@@ -95,14 +97,21 @@ BagFiles bagFiles(const fs::path& folder) {
     out.storage = info["storage_identifier"].as<std::string>("sqlite3");
     const std::string compression = info["compression_format"].as<std::string>("");
     if (!compression.empty())
-      fail(meta, "compressed bag (" + compression + "); decompress it with `ros2 bag convert`");
-    for (const auto& f : info["relative_file_paths"])
-      out.files.push_back(folder / f.as<std::string>());
+      fail(meta, "compressed bag (" + shownText(compression) +
+                     "); decompress it with `ros2 bag convert`");
+    for (const auto& f : info["relative_file_paths"]) {
+      // folder / "/x.db3" would be /x.db3: a path outside the bag, named without it.
+      const fs::path file = f.as<std::string>();
+      if (file.empty() || file.is_absolute())
+        fail(meta, "relative_file_paths: '" + shownText(file.string()) +
+                       "' is not a path relative to the bag folder");
+      out.files.push_back(folder / file);
+    }
   } catch (const YAML::Exception& e) {
-    fail(meta, std::string("not a readable bag description (") + e.what() + ")");
+    fail(meta, "not a readable bag description (" + shownText(e.what(), 200) + ")");
   }
   if (out.storage != "sqlite3" && out.storage != "mcap")
-    fail(meta, "storage '" + out.storage + "' is not read (sqlite3, mcap)");
+    fail(meta, "storage '" + shownText(out.storage) + "' is not read (sqlite3, mcap)");
   if (out.files.empty()) fail(meta, "relative_file_paths lists no file");
   return out;
 }
@@ -171,8 +180,8 @@ std::vector<MessageRef> Ros2Bag::messages(const std::string& topic) {
   for (const auto& [file, t] : found->second) {
     const Database& db = *dbs_[file];
     if (t.serialization != "cdr")
-      fail(db.file(),
-           "topic " + topic + " is serialized as '" + t.serialization + "'; only cdr is read");
+      fail(db.file(), "topic " + shownText(topic) + " is serialized as '" +
+                          shownText(t.serialization) + "'; only cdr is read");
     Stmt s =
         db.prepare("SELECT id, timestamp FROM messages WHERE topic_id = ? ORDER BY timestamp, id");
     sqlite3_bind_int64(s.get(), 1, t.id);
@@ -193,7 +202,7 @@ SerializedMessage Ros2Bag::readBytes(const std::string& topic, const MessageRef&
   if (prefix >= 0) sqlite3_bind_int64(s.get(), arg++, prefix);
   sqlite3_bind_int64(s.get(), arg, ref.row);
   if (!db.step(s.get()))
-    fail(db.file(), "message " + std::to_string(ref.row) + " on " + topic + " is gone");
+    fail(db.file(), "message " + std::to_string(ref.row) + " on " + shownText(topic) + " is gone");
   const void* data = sqlite3_column_blob(s.get(), 0);
   const int size = sqlite3_column_bytes(s.get(), 0);
   SerializedMessage m;
