@@ -12,8 +12,7 @@ namespace semsegmap {
 void note(const std::string& text);
 void warn(const std::string& text);
 
-// The whole line ("note: ...", no newline) to `sink`; an empty sink restores stderr. Not for
-// use while another thread may print.
+// The whole line ("note: ...", no newline) to `sink`; an empty sink restores stderr.
 void setMessageSink(std::function<void(const std::string& line)> sink);
 
 }  // namespace semsegmap

@@ -1,7 +1,6 @@
 #include "semsegmap/io/dataset_format.h"
 
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -33,12 +32,6 @@ std::string frameFileName(size_t index, const std::string& extension) {
   std::snprintf(digits, sizeof(digits), "%06zu", index);
   // Accept "png" and ".png" alike; callers have written both.
   return std::string(digits) + (extension.rfind('.', 0) == 0 ? "" : ".") + extension;
-}
-
-std::string formatExactDouble(double value) {
-  char text[64];
-  const auto result = std::to_chars(text, text + sizeof(text), value);
-  return std::string(text, result.ptr);
 }
 
 void checkLabelClasses(const fs::path& path, const std::vector<PointLabel>& labels,

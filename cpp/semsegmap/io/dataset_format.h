@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "semsegmap/core/exact_text.h"  // formatExactDouble, for the writers
 #include "semsegmap/core/frame_source.h"
 
 namespace semsegmap {
@@ -18,10 +19,6 @@ std::string frameFileName(size_t index, const std::string& extension);
 
 // First line of frames.csv; the reader requires it verbatim.
 extern const char* const kFramesCsvHeader;
-
-// Shortest decimal text that parses back to exactly `value` (std::to_chars), so that meta.yaml
-// and frames.csv round-trip bit-exactly yet stay readable (0.1, not 0.10000000000000001).
-std::string formatExactDouble(double value);
 
 // Throw std::runtime_error "<path>: ..." when a label uses a class id that `classes` lacks, so a
 // dataset never holds ids that ClassTable::at cannot look up later in the pipeline.

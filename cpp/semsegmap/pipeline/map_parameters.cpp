@@ -1,21 +1,19 @@
 #include "semsegmap/pipeline/map_parameters.h"
 
-#include <charconv>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 
 #include "semsegmap/core/diagnostics.h"
+#include "semsegmap/core/exact_text.h"
 
 namespace semsegmap {
 
 namespace {
 
-// Shortest text that reads back as exactly `value`: equal text is equal settings.
+// Text that reads back as exactly `value`: equal text is equal settings.
 std::string exact(double value) {
-  char text[64];
-  const auto result = std::to_chars(text, text + sizeof(text), value);
-  return std::string(text, result.ptr);
+  return formatExactDouble(value);
 }
 std::string exact(bool value) {
   return value ? "true" : "false";
