@@ -262,7 +262,7 @@ TEST(Cli, EveryCommandHasItsOwnHelp) {
 TEST(Cli, HelpShowsDefaultsAndRequiredOptions) {
   const Result& map = help("map");
   EXPECT_NE(map.out.find("--points N"), std::string::npos);
-  EXPECT_NE(map.out.find("(default: 0)"), std::string::npos);
+  EXPECT_NE(map.out.find("(default: 0)"), std::string::npos);  // --max-frames
   EXPECT_NE(map.out.find("(required)"), std::string::npos);
   if (built("demo")) {
     EXPECT_NE(help("demo").out.find("(default: demo_out)"), std::string::npos);
@@ -715,6 +715,25 @@ class CliMaps : public ::testing::Test {
   std::string data_, config_;
   std::filesystem::path map_;
 };
+
+// `map` without --points keeps the points its configuration asks for, so that a configuration
+// that refines poses (config/semsegmap-kitti.yaml) builds maps its own localization accepts.
+TEST_F(CliMaps, MapKeepsTheConfiguredSegmentPointsUnlessPointsIsGiven) {
+  const std::string refine =
+      eigenConfig(tmp_.path(), "refine.yaml",
+                  "target_map:\n  max_points_per_segment: 8\nrefinement:\n  enabled: true\n");
+  const std::filesystem::path with = tmp_.path() / "with.map", none = tmp_.path() / "none.map";
+  ASSERT_EQ(run("map" + data_ + " --config " + refine + " --out " + with.string()).code, 0);
+  const Result uses = localize(refine, with);
+  EXPECT_EQ(uses.code, 0) << uses.err;
+  std::filesystem::remove_all(out());
+  ASSERT_EQ(run("map" + data_ + " --config " + refine + " --points 0 --out " + none.string()).code,
+            0);
+  EXPECT_GT(std::filesystem::file_size(with), std::filesystem::file_size(none));
+  const Result refused = localize(refine, none);
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_NE(refused.err.find("stores no segment points"), std::string::npos) << refused.err;
+}
 
 // A map grown with another growing radius localized 0 frames with exit 0 and no warning.
 TEST_F(CliMaps, AMapBuiltWithOtherSettingsIsRefusedUnlessAllowed) {

@@ -16,10 +16,13 @@ namespace semsegmap::app {
 namespace {
 
 int runMap(const CliArgs& a) {
-  const size_t points = a.getCount("points");
-  if (points > 65535)
-    throw UsageError("option --points must be in 0..65535, got " + a.get("points"));
   PipelineConfig config = loadPipelineConfig(a.get("config"));
+  // Without --points the configuration's target_map.max_points_per_segment holds: a config that
+  // refines poses (config/semsegmap-kitti.yaml) builds maps its localization can use.
+  const size_t points =
+      a.has("points") ? a.getCount("points") : config.target_map.max_points_per_segment;
+  if (points > 65535)
+    throw UsageError("option --points must be in 0..65535, got " + std::to_string(points));
   const std::filesystem::path out = a.get("out");
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
   auto source = openDatasetArg(a);
@@ -76,8 +79,9 @@ const CommandSpec& mapCommand() {
               {"poses", Value::kText, "gt|odom|slam", "",
                "poses the map is built with (default: gt when the data has them, else odom)"},
               maxFramesOption(),
-              {"points", Value::kCount, "N", "0",
-               "points kept per segment, for pictures and pose refinement (refinement:), 0..65535"},
+              {"points", Value::kCount, "N", "",
+               "points kept per segment, for pictures and pose refinement (refinement:), 0..65535 "
+               "(default: the config's target_map.max_points_per_segment)"},
               {"float32", Value::kFlag, "", "", "store descriptors as float32 instead of float16"},
           }),
       kDatasetNotes, runMap};
