@@ -18,11 +18,13 @@ namespace {
 int runMap(const CliArgs& a) {
   PipelineConfig config = loadPipelineConfig(a.get("config"));
   // Without --points the configuration's target_map.max_points_per_segment holds: a config that
-  // refines poses (config/semsegmap-kitti.yaml) builds maps its localization can use.
-  const size_t points =
-      a.has("points") ? a.getCount("points") : config.target_map.max_points_per_segment;
-  if (points > 65535)
-    throw UsageError("option --points must be in 0..65535, got " + std::to_string(points));
+  // refines poses builds maps its localization can use.
+  if (a.has("points")) {
+    const size_t points = a.getCount("points");
+    if (points > 65535)
+      throw UsageError("option --points must be in 0..65535, got " + a.get("points"));
+    config.target_map.max_points_per_segment = points;
+  }
   const std::filesystem::path out = a.get("out");
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
   auto source = openDatasetArg(a);
@@ -31,7 +33,6 @@ int runMap(const CliArgs& a) {
   const std::string poses = a.has("poses")                          ? a.get("poses")
                             : source->info().has_ground_truth_poses ? "gt"
                                                                     : "odom";
-  config.target_map.max_points_per_segment = points;
 
   Progress progress("map", 0);
   RunOptions options;

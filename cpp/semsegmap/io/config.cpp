@@ -370,7 +370,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"min_correspondences", count(rf.min_correspondences, 0, kMaxPoints)}});
   readSection(path, root, "target_map",
               {{"duplicate_distance_m", set(c.target_map.duplicate_distance_m)},
-               {"max_points_per_segment", count(c.target_map.max_points_per_segment, 0, 1000000)}});
+               // The map file stores a segment's point count in 16 bits (io/map_file.cpp).
+               {"max_points_per_segment", count(c.target_map.max_points_per_segment, 0, 65535)}});
   auto& lc = c.loop_closure;
   readSection(path, root, "loop_closure",
               {{"exclude_recent_m", set(lc.exclude_recent_m)},
