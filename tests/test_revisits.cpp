@@ -216,20 +216,23 @@ TEST(RevisitExperiment, RealKittiRevisitsAreFoundAndNoneIsFarOff) {
   // the mapped ones move that far, and the localizations agree with the map's geometry.
   EXPECT_GE(e.registered, 3u);
   EXPECT_GT(e.mean_correction_m, 0.5);
-  EXPECT_GE(r.registered_compared, 2u);
+  // Refined on the map's segment points, every localization is within 0.3 m and 1 degree.
+  EXPECT_GE(r.registered_compared, 3u);
   for (const RevisitLocalization& l : r.localizations) {
     if (l.registered_error_m >= 0) {
       EXPECT_LT(l.registered_error_m, 0.3) << "frame " << l.frame;
+      EXPECT_LT(l.registered_rotation_error_deg, 1.0) << "frame " << l.frame;
     }
   }
-  EXPECT_GE(r.registered_below_0_3m, 2u) << "within 0.3 m and 1 degree";
+  EXPECT_EQ(r.registered_below_0_3m, r.registered_compared) << "within 0.3 m and 1 degree";
   // The shipped configuration names no LiDAR-only model: the colour model sees geometry alone,
   // and the run says so.
   EXPECT_NE(r.model_note.find("no colour and no classes"), std::string::npos) << r.model_note;
 }
 
 // Woken up with an empty local map at the revisit, from the sparse scans 10-20 m apart: a single
-// scan does not localize, the second one does.
+// scan does not localize, the second one does. Judged against the registered ground truth: the
+// refined poses agree with the map, and poses.txt puts the second pass about 0.8 m too high.
 TEST(RevisitExperiment, RealKittiWakeUpLocalizesFromTwoScans) {
   SEMSEGMAP_SKIP_WITHOUT_KITTI_SPARSE();
   SEMSEGMAP_SKIP_WITHOUT_TORCH();
@@ -239,6 +242,7 @@ TEST(RevisitExperiment, RealKittiWakeUpLocalizesFromTwoScans) {
   cfg.map_frames = parseFrameRanges("0:23", "map");
   cfg.query_frames = parseFrameRanges("25:35", "query");
   parseWakeUp("2", "wake-up", cfg);
+  cfg.check_ground_truth = true;
   cfg.configs = {loadNamedConfig(kSource + "/config/semsegmap-kitti.yaml")};
   const RevisitExperiment e = evaluateRevisits(*source, cfg, tmp.path());
   const RevisitResult& r = e.results.at(0);

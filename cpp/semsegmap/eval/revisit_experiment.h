@@ -55,7 +55,8 @@ struct WakeUp {              // one wake-up of one configuration
   FrameRange frames;         // the dataset's frames it localized from
   bool revisit = false;      // its first frame is at a revisit
   size_t localized = 0;      // 1 + frames after waking up until the first localization within
-                             // correct_m; 0: none
+                             // correct_m (of the registered ground truth where the scan
+                             // registered, check_ground_truth); 0: none
   bool wrong_first = false;  // a localization more than wrong_m off came before any correct one
 };
 
