@@ -181,14 +181,18 @@ int runTrain(const CliArgs& a) {
   callbacks.step = [&](int epoch, size_t done, size_t total, double loss) {
     progress.step(epoch, done, total, loss);
   };
-  callbacks.epoch = [&](const EpochStats& s) { progress.epoch(s); };
+  // The history so far goes to its file after every epoch, before the epoch is printed: a run
+  // stopped early (a day's budget, a killed job) keeps both its best model and its history.
+  std::vector<EpochStats> history;
+  callbacks.epoch = [&](const EpochStats& s) {
+    history.push_back(s);
+    if (a.has("history")) writeHistoryCsv(a.get("history"), history);
+    progress.epoch(s);
+  };
   callbacks.best = [&](DescriptorNetImpl& net) { saveNet(out, net); };
   const TrainResult result = trainDescriptor(data, config, callbacks);
 
-  if (a.has("history")) {
-    writeHistoryCsv(a.get("history"), result.history);
-    std::cout << "wrote " << a.get("history") << "\n";
-  }
+  if (a.has("history")) std::cout << "wrote " << a.get("history") << "\n";
   std::printf("trained on %zu observations (%zu anchors), validated on %zu\n",
               result.train_observations, result.anchors, result.validation_observations);
   const EpochStats& best = result.history.at(static_cast<size_t>(result.best_epoch - 1));
@@ -254,7 +258,7 @@ const CommandSpec& trainCommand() {
           {"points", Value::kPositive, "N", "",
            "points a segment is subsampled to " +
                shown([](const TrainConfig& c) { return c.net.num_points; })},
-          {"history", Value::kText, "FILE.csv", "", "also write one row per epoch"},
+          {"history", Value::kText, "FILE.csv", "", "also write one row per epoch, after each"},
       },
       std::string("--dataset: a key=value after a sim: spec belongs to it, any other item starts a "
                   "new spec\n(';' also separates): sim:world=1,run=S1,sim:world=1,run=S1,"
