@@ -66,23 +66,51 @@ struct PcdLayout {
   int data_type = -1;  // 0 ascii, 1 binary, 2 binary_compressed
 };
 
-std::vector<uint64_t> countsOf(std::istringstream& words) {
+// A header line's words as PCL splits them: at spaces, tabs and carriage returns only.
+std::vector<std::string> pcdWords(const std::string& line) {
+  std::vector<std::string> words;
+  size_t at = 0;
+  while ((at = line.find_first_not_of(" \t\r", at)) != std::string::npos) {
+    const size_t end = std::min(line.find_first_of(" \t\r", at), line.size());
+    words.push_back(line.substr(at, end - at));
+    at = end;
+  }
+  return words;
+}
+
+std::vector<uint64_t> countsOf(const std::vector<std::string>& words) {
   std::vector<uint64_t> out;
-  for (std::string w; words >> w;)
+  for (size_t i = 1; i < words.size(); ++i) {
+    const std::string& w = words[i];
     out.push_back(w.size() <= 12 && w.find_first_not_of("0123456789") == std::string::npos
                       ? std::stoull(w)
                       : kCountCap);  // not a count: refused as too large
+  }
   return out;
 }
 
-void readPcdLine(const std::string& line, PcdLayout& l, std::vector<uint64_t>& sizes,
-                 std::vector<uint64_t>& counts, uint64_t& width_height) {
-  std::istringstream words(line);
-  std::string key;
-  words >> key;
+// PCL takes a line for a key when its first word starts with it ("COUNT\b" is COUNT), so a key
+// is read here the same way, and a word that only starts with one is refused.
+std::string pcdKey(const fs::path& path, const std::string& word) {
+  for (const char* key : {"VERSION", "FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH",
+                          "HEIGHT", "VIEWPOINT", "POINTS", "DATA"})
+    if (word.rfind(key, 0) == 0) {
+      if (word != key)
+        throw std::runtime_error(path.string() + ": not a readable PCD header: the key '" + key +
+                                 "' runs on into other characters");
+      return word;
+    }
+  return word;
+}
+
+void readPcdLine(const fs::path& path, const std::string& line, PcdLayout& l,
+                 std::vector<uint64_t>& sizes, std::vector<uint64_t>& counts,
+                 uint64_t& width_height) {
+  const std::vector<std::string> words = pcdWords(line);
+  if (words.empty() || words[0][0] == '#') return;
+  const std::string key = pcdKey(path, words[0]);
   if (key == "DATA") {
-    std::string type;
-    words >> type;
+    const std::string type = words.size() > 1 ? words[1] : "";
     l.data_type = type == "ascii" ? 0 : type == "binary" ? 1 : type == "binary_compressed" ? 2 : -1;
     return;
   }
@@ -104,13 +132,18 @@ PcdLayout scanPcdHeader(const fs::path& path) {
   uint64_t width_height = 0;
   std::string line;
   for (int n = 0; n < 100 && l.data_type < 0 && std::getline(in, line); ++n)
-    readPcdLine(line, l, sizes, counts, width_height);
+    readPcdLine(path, line, l, sizes, counts, width_height);
   if (l.data_type < 0 || sizes.empty())
     throw std::runtime_error(path.string() + ": not a readable PCD header");
+  // The format knows fields of 1, 2, 4 and 8 bytes; PCL takes any SIZE at its word and
+  // allocates the points with it (SIZE 77777777771 is 12 GB for 3 points).
+  for (const uint64_t size : sizes)
+    if (size != 1 && size != 2 && size != 4 && size != 8)
+      throw std::runtime_error(path.string() +
+                               ": not a readable PCD header: a SIZE that is not 1, 2, 4 or 8");
   for (size_t i = 0; i < sizes.size(); ++i) {
     const uint64_t count = i < counts.size() ? std::max<uint64_t>(counts[i], 1) : 1;
-    l.point_step = std::min(
-        l.point_step + std::min<uint64_t>(sizes[i], 8) * std::min(count, kStepCap), kStepCap);
+    l.point_step = std::min(l.point_step + sizes[i] * std::min(count, kStepCap), kStepCap);
     l.values = std::min(l.values + std::min(count, kStepCap), kStepCap);
   }
   l.points = std::max(l.points, width_height);
