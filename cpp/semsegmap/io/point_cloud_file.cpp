@@ -251,7 +251,8 @@ void readPlyLine(const std::string& line, PlyHeader& h, bool& in_vertex, uint64_
     h.properties += in_vertex;
   } else if (word == "property" && a == "list" && words >> c >> name && isPlyType(b) &&
              isPlyType(c) && !(words >> rest)) {
-    h.properties += in_vertex;
+    // PCL asserts on the contents of some vertex lists; a point cloud's vertices have none.
+    if (in_vertex) throw std::invalid_argument("a list property in the vertex element");
   } else {
     throw std::invalid_argument(line.substr(0, 40));
   }
