@@ -362,23 +362,23 @@ TEST(PointCloudFile, OversizedHeadersAreRefusedBeforeReading) {
             head + "WIDTH 1000\nHEIGHT 1\nPOINTS 1000\nDATA ascii\n1 2 3\n");
   EXPECT_NE(errorOf([&] { readPointCloudFile(tmp.path() / "few.pcd"); }).find("few.pcd: "),
             std::string::npos);
+  const auto refusalOf = [&](const std::string& name, const std::string& text) {
+    writeText(tmp.path() / name, text);
+    return errorOf([&] { readPointCloudFile(tmp.path() / name); });
+  };
   // A field of 77777777771 bytes: PCL allocated 12 GB for 3 points (found by the fuzzer).
-  writeText(tmp.path() / "wide.pcd",
-            "VERSION 0.7\nFIELDS x y z\nSIZE 77777777771 4 4\n"
-            "TYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\n"
-            "DATA ascii\n1 2 3\n4 5 6\n7 8 9\n");
-  EXPECT_NE(errorOf([&] {
-              readPointCloudFile(tmp.path() / "wide.pcd");
-            }).find("wide.pcd: not a readable PCD header: a SIZE that is not 1, 2, 4 or 8"),
+  EXPECT_NE(refusalOf("wide.pcd",
+                      "VERSION 0.7\nFIELDS x y z\nSIZE 77777777771 4 4\n"
+                      "TYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\n"
+                      "DATA ascii\n1 2 3\n4 5 6\n7 8 9\n")
+                .find("wide.pcd: not a readable PCD header: a SIZE that is not 1, 2, 4 or 8"),
             std::string::npos);
   // PCL reads "COUNT\b" as COUNT, so a check that did not went by its counts (a segfault).
-  writeText(tmp.path() / "key.pcd",
-            "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
-            "COUNT\b 1 1 99999999999999999999\nWIDTH 1\nHEIGHT 1\n"
-            "POINTS 1\nDATA binary\n123456789012");
-  EXPECT_NE(errorOf([&] {
-              readPointCloudFile(tmp.path() / "key.pcd");
-            }).find("key.pcd: not a readable PCD header: the key 'COUNT' runs on"),
+  EXPECT_NE(refusalOf("key.pcd",
+                      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
+                      "COUNT\b 1 1 99999999999999999999\nWIDTH 1\nHEIGHT 1\n"
+                      "POINTS 1\nDATA binary\n123456789012")
+                .find("key.pcd: not a readable PCD header: the key 'COUNT' runs on"),
             std::string::npos);
   writeText(tmp.path() / "huge.ply",
             "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"

@@ -89,18 +89,14 @@ std::vector<uint64_t> countsOf(const std::vector<std::string>& words) {
   return out;
 }
 
-// PCL takes a line for a key when its first word starts with it ("COUNT\b" is COUNT), so a key
-// is read here the same way, and a word that only starts with one is refused.
-std::string pcdKey(const fs::path& path, const std::string& word) {
+// PCL takes a line for a key when its first word starts with it ("COUNT\b" is COUNT), so a word
+// that only starts with a key is refused: read by its exact word, the line would go unchecked.
+void refuseRunOnKey(const fs::path& path, const std::string& word) {
   for (const char* key : {"VERSION", "FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH",
                           "HEIGHT", "VIEWPOINT", "POINTS", "DATA"})
-    if (word.rfind(key, 0) == 0) {
-      if (word != key)
-        throw std::runtime_error(path.string() + ": not a readable PCD header: the key '" + key +
-                                 "' runs on into other characters");
-      return word;
-    }
-  return word;
+    if (word.rfind(key, 0) == 0 && word != key)
+      throw std::runtime_error(path.string() + ": not a readable PCD header: the key '" + key +
+                               "' runs on into other characters");
 }
 
 void readPcdLine(const fs::path& path, const std::string& line, PcdLayout& l,
@@ -108,7 +104,8 @@ void readPcdLine(const fs::path& path, const std::string& line, PcdLayout& l,
                  uint64_t& width_height) {
   const std::vector<std::string> words = pcdWords(line);
   if (words.empty() || words[0][0] == '#') return;
-  const std::string key = pcdKey(path, words[0]);
+  const std::string& key = words[0];
+  refuseRunOnKey(path, key);
   if (key == "DATA") {
     const std::string type = words.size() > 1 ? words[1] : "";
     l.data_type = type == "ascii" ? 0 : type == "binary" ? 1 : type == "binary_compressed" ? 2 : -1;
