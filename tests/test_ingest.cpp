@@ -389,6 +389,46 @@ TEST(PointCloudFile, OversizedHeadersAreRefusedBeforeReading) {
       << ply;
 }
 
+// PCL places a field by SIZE and COUNT but writes it at the width of its TYPE (4-byte floats
+// when TYPE is missing, the first TYPE when SIZE comes again): both wrote past PCL's buffer.
+TEST(PointCloudFile, FieldsWiderThanTheirSizeAreRefused) {
+  TempDir tmp;
+  const std::string counts = "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n";
+  const std::string tail = counts + "1 2 3\n4 5 6\n";
+  for (const auto& [name, head] :
+       {std::pair{"untyped.pcd", "FIELDS x y z\nSIZE 1 1 1\n"},
+        std::pair{"twice.pcd",
+                  "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nSIZE 1 1 1\nCOUNT 1 1 1\n"}}) {
+    writeText(tmp.path() / name, head + tail);
+    const std::string error = errorOf([&] { readPointCloudFile(tmp.path() / name); });
+    EXPECT_NE(error.find(std::string(name) + ": not a readable PCD header: the field 'x' has a "
+                                             "TYPE that does not fit its SIZE and COUNT"),
+              std::string::npos)
+        << error;
+  }
+  // PCL sizes its buffer at POINTS with the point size it knows by then.
+  for (const char* data : {"ascii", "binary"}) {
+    writeText(tmp.path() / "early.pcd",
+              "FIELDS x y z\nPOINTS 2\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+              "DATA " +
+                  std::string(data) + "\n" + std::string(48, '1'));
+    EXPECT_NE(errorOf([&] {
+                readPointCloudFile(tmp.path() / "early.pcd");
+              }).find("early.pcd: not a readable PCD header: POINTS comes before SIZE or COUNT"),
+              std::string::npos)
+        << data;
+  }
+  // Sizes and types that agree read, whatever the field widths.
+  writeText(tmp.path() / "mixed.pcd",
+            "FIELDS x y z i\nSIZE 8 4 4 1\nTYPE F F F U\nCOUNT 1 1 1 1\n" + counts +
+                "1 2 3 7\n4 5 6 8\n");
+  const DecodedPoints d = readPointCloudFile(tmp.path() / "mixed.pcd");
+  ASSERT_EQ(d.points.size(), 2u);
+  EXPECT_FLOAT_EQ(d.points[1].x, 4.0f);
+  EXPECT_FLOAT_EQ(d.points[1].z, 6.0f);
+  EXPECT_FLOAT_EQ(d.points[1].intensity, 8.0f);
+}
+
 TEST(PointCloudFile, ReadsPlyInBothEncodings) {
   TempDir tmp;
   pcl::PointCloud<pcl::PointXYZI> cloud;

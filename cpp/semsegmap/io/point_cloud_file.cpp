@@ -12,6 +12,7 @@
 
 #if SEMSEGMAP_WITH_PCL
 #include <pcl/PCLPointCloud2.h>
+#include <pcl/common/io.h>
 #include <pcl/console/print.h>
 #include <pcl/exceptions.h>
 #include <pcl/io/pcd_io.h>
@@ -177,10 +178,38 @@ struct QuietPcl {
   ~QuietPcl() { pcl::console::setVerbosityLevel(level); }
 };
 
+// PCL takes a field's place (offset, point_step) from SIZE and COUNT but writes values of the
+// width its TYPE implies, with TYPE defaulting to 4-byte floats and later lines overriding
+// earlier ones: "SIZE 1 1 1" without a TYPE, or a second SIZE after the TYPE, makes it write
+// past the end of its buffer (heap overflows, behind a fuzzer finding). Every field must hold
+// what PCL will write into it, its buffer hold every point, and the point be the size the file
+// was checked against.
+void checkPcdFields(const fs::path& path, const pcl::PCLPointCloud2& header,
+                    const PcdLayout& layout) {
+  for (const pcl::PCLPointField& f : header.fields) {
+    const uint64_t size = pcl::getFieldSize(f.datatype);
+    if (size == 0 || f.offset + size * std::max<uint64_t>(f.count, 1) > header.point_step)
+      throw std::runtime_error(path.string() + ": not a readable PCD header: the field '" + f.name +
+                               "' has a TYPE that does not fit its SIZE and COUNT");
+  }
+  // PCL sizes its buffer when it reads POINTS, with the point size known by then: POINTS before
+  // SIZE or COUNT leaves it too small for what they declare next (another overflow).
+  const uint64_t points = static_cast<uint64_t>(header.width) * header.height;
+  if (header.data.size() != points * header.point_step)
+    throw std::runtime_error(path.string() +
+                             ": not a readable PCD header: POINTS comes before SIZE or COUNT");
+  if (header.point_step != layout.point_step)
+    throw std::runtime_error(path.string() + ": not a readable PCD header: PCL reads points of " +
+                             std::to_string(header.point_step) + " bytes where SIZE and COUNT " +
+                             "give " + std::to_string(layout.point_step) +
+                             " (a key given twice or out of order, or a COUNT of 0)");
+}
+
 // PCL returns a code (or throws, naming no file); the header is read first so that the error
 // says what is wrong (a truncated binary file, a point count the data does not hold).
 DecodedPoints readPcd(const fs::path& path) {
-  checkPcdSize(path, scanPcdHeader(path));
+  const PcdLayout layout = scanPcdHeader(path);
+  checkPcdSize(path, layout);
   const QuietPcl quiet;
   pcl::PCDReader reader;
   pcl::PCLPointCloud2 header, cloud;
@@ -197,6 +226,7 @@ DecodedPoints readPcd(const fs::path& path) {
   // PCL accepts a header without fields or data (an empty file) and then crashes reading it.
   if (rc < 0 || header.fields.empty() || data_index == 0 || data_index > fs::file_size(path))
     throw std::runtime_error(path.string() + ": not a readable PCD header");
+  checkPcdFields(path, header, layout);
   try {
     rc = reader.read(path.string(), cloud);
   } catch (const std::exception&) {  // PCLException, and std::out_of_range of its vectors
