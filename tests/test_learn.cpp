@@ -209,6 +209,48 @@ TEST(Augment, ConfusedSectionsOffKeepTheRecipeBeforeThem) {
   EXPECT_GT(differ, 0u) << "building points have a partner class (fence)";
 }
 
+TEST(Augment, ModalityDropoutTakesAllColourOrAllClassesOfAnObservation) {
+  const EnrichedCloud cloud = randomCloud(300, 10);
+  AugmentConfig config;
+  config.modality_dropout_probability = 0.5;
+  int grey = 0, unknown = 0, both = 0;
+  const int draws = 400;
+  for (int seed = 0; seed < draws; ++seed) {
+    std::mt19937 rng(static_cast<uint32_t>(seed));
+    const EnrichedCloud out = augment(cloud, config, rng);
+    size_t colored = 0, classed = 0;
+    for (const EnrichedPoint& p : out) {
+      colored += p.has_color;
+      classed += p.class_id != cls::kUnknown;
+    }
+    // All or nothing: a sensor lacks a modality for the whole segment, never for a few points
+    // (the 10 % wrong labels never draw unknown).
+    ASSERT_TRUE(colored == 0 || colored == out.size()) << seed;
+    ASSERT_TRUE(classed == 0 || classed == out.size()) << seed;
+    grey += colored == 0, unknown += classed == 0, both += colored == 0 && classed == 0;
+  }
+  EXPECT_NEAR(grey, draws / 2, draws / 8) << "colour dropped with the probability given";
+  EXPECT_NEAR(unknown, draws / 2, draws / 8) << "classes dropped with the probability given";
+  EXPECT_NEAR(both, draws / 4, draws / 10) << "the two drawn separately";
+  const EnrichedCloud geometry = dropModalities(cloud, true, true);
+  EXPECT_EQ(geometry[7].x, cloud[7].x);
+  EXPECT_EQ(geometry[7].v, 0.0f) << "grey, as the network input of a point without colour";
+}
+
+TEST(Augment, ModalityDropoutOffKeepsTheRecipeBeforeIt) {
+  const EnrichedCloud cloud = randomCloud(1000, 11);
+  AugmentConfig with;
+  with.modality_dropout_probability = 1.0;
+  std::mt19937 a(11), b(11);
+  const EnrichedCloud off = augment(cloud, AugmentConfig{}, a);
+  const EnrichedCloud on = augment(cloud, with, b);
+  ASSERT_EQ(off.size(), on.size());
+  for (size_t i = 0; i < off.size(); ++i) {
+    EXPECT_EQ(off[i].x, on[i].x) << "the same draws up to the dropout";
+    EXPECT_TRUE(off[i].has_color && !on[i].has_color);
+  }
+}
+
 // ---- Pairs, split, retrieval -------------------------------------------------------------------
 
 TEST(TrainingData, PositivesShareALandmarkNegativesDoNot) {

@@ -132,6 +132,14 @@ void writeHistoryCsv(const std::filesystem::path& path, const std::vector<EpochS
   });
 }
 
+double probability(const CliArgs& a, const std::string& option) {
+  const double p = a.getNumber(option);
+  if (!(p >= 0 && p <= 1))
+    throw std::invalid_argument("--" + option + ": " + a.get(option) +
+                                " is not a probability in [0, 1]");
+  return p;
+}
+
 // The training settings from the options; what is not given keeps the library's default for
 // the descriptor (defaultTrainConfig).
 TrainConfig trainConfig(const CliArgs& a) {
@@ -143,18 +151,19 @@ TrainConfig trainConfig(const CliArgs& a) {
   if (a.has("lr")) config.learning_rate = a.getNumber("lr");
   if (a.has("anchors-per-epoch")) config.anchors_per_epoch = a.getCount("anchors-per-epoch");
   if (a.has("seed")) config.seed = a.getCount("seed");
-  if (a.has("confused-sections")) {
-    const double p = a.getNumber("confused-sections");
-    if (!(p >= 0 && p <= 1))
-      throw std::invalid_argument("--confused-sections: " + a.get("confused-sections") +
-                                  " is not a probability in [0, 1]");
-    config.augmentation.confused_section_probability = p;
-  }
-  if (a.has("lidar-only")) {
+  if (a.has("confused-sections"))
+    config.augmentation.confused_section_probability = probability(a, "confused-sections");
+  if (a.has("modality-dropout"))
+    config.augmentation.modality_dropout_probability = probability(a, "modality-dropout");
+  if (a.has("lidar-only") || a.has("modality-dropout")) {
     if (config.net.kind != DescriptorKind::kSemSegMapNet)
-      throw UsageError("--lidar-only: only semsegmap-net sees colour and classes");
-    config.net.use_color = config.net.use_classes = false;
+      throw UsageError(std::string("--") +
+                       (a.has("lidar-only") ? "lidar-only" : "modality-dropout") +
+                       ": only semsegmap-net sees colour and classes");
+    if (a.has("lidar-only") && a.has("modality-dropout"))
+      throw UsageError("--modality-dropout: a --lidar-only network sees neither modality anyway");
   }
+  if (a.has("lidar-only")) config.net.use_color = config.net.use_classes = false;
   validateNetConfig(config.net);  // before the long extraction, not after it
   return config;
 }
@@ -251,6 +260,13 @@ const CommandSpec& trainCommand() {
            "vegetation, terrain/sidewalk, missed poles) " +
                shown([](const TrainConfig& c) {
                  return c.augmentation.confused_section_probability;
+               })},
+          {"modality-dropout", Value::kNumber, "P", "",
+           "probability, drawn separately for colour and for classes, that a training "
+           "observation loses all of it, so that the model also serves a LiDAR without a camera "
+           "or a segmentation network " +
+               shown([](const TrainConfig& c) {
+                 return c.augmentation.modality_dropout_probability;
                })},
           {"lidar-only", Value::kFlag, "", "",
            "the network sees geometry only (no colour, no classes): the model for a LiDAR "

@@ -169,6 +169,18 @@ EnrichedCloud relabelPoints(const EnrichedCloud& cloud, double fraction, int num
   return out;
 }
 
+EnrichedCloud dropModalities(const EnrichedCloud& cloud, bool drop_color, bool drop_classes) {
+  EnrichedCloud out = cloud;
+  for (EnrichedPoint& p : out) {
+    if (drop_color) {
+      p.h = p.s = p.v = 0;
+      p.has_color = false;
+    }
+    if (drop_classes) p.class_id = cls::kUnknown;
+  }
+  return out;
+}
+
 EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, std::mt19937& rng) {
   EnrichedCloud out = cloud;
   if (std::bernoulli_distribution(config.section_cut_probability)(rng))
@@ -187,6 +199,11 @@ EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, s
   if (config.confused_section_probability > 0 &&
       std::bernoulli_distribution(config.confused_section_probability)(rng))
     out = confuseSection(out, uniform(rng, 0.0, config.max_confused_fraction), rng);
+  if (config.modality_dropout_probability > 0) {
+    std::bernoulli_distribution dropped(config.modality_dropout_probability);
+    const bool drop_color = dropped(rng);
+    out = dropModalities(out, drop_color, dropped(rng));
+  }
   return out;
 }
 

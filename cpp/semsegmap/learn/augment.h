@@ -30,6 +30,11 @@ struct AugmentConfig {
   // the random draws, and so the models, of the recipe before it.
   double confused_section_probability = 0.0;
   double max_confused_fraction = 0.5;
+  // One shipped model must also serve a robot without a camera (no colour) or without a
+  // segmentation network (no classes), and there every point of a segment lacks them, not a
+  // few: with this probability, drawn separately for each, an observation loses all its colour
+  // or all its classes. 0 keeps the draws of the recipe before it.
+  double modality_dropout_probability = 0.0;
   int num_classes = 15;  // wrong classes are drawn from 1 .. num_classes - 1
 };
 
@@ -61,6 +66,10 @@ EnrichedCloud relabelPoints(const EnrichedCloud& cloud, double fraction, int num
 // network confuses theirs with (one partner choice for the whole section), thin objects a
 // building or vegetation behind them. Classes without a partner keep theirs.
 EnrichedCloud confuseSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng);
+
+// Every point without colour (grey, has_color false) when drop_color, of class unknown when
+// drop_classes: the observation as a sensor without that modality gives it.
+EnrichedCloud dropModalities(const EnrichedCloud& cloud, bool drop_color, bool drop_classes);
 
 // All of the above with random strengths within `config`.
 EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, std::mt19937& rng);
