@@ -193,13 +193,18 @@ TEST(Augment, ConfusedSectionTakesTheClassANetworkConfusesItWith) {
   EXPECT_EQ(pole_became, fence_became) << "a missed pole takes the class behind it";
 }
 
+// The same cloud augmented with the default recipe and with `with`, from the same seed.
+std::pair<EnrichedCloud, EnrichedCloud> augmentedOffAndOn(const AugmentConfig& with,
+                                                          uint32_t seed) {
+  const EnrichedCloud cloud = randomCloud(1000, seed);
+  std::mt19937 a(seed), b(seed);
+  return {augment(cloud, AugmentConfig{}, a), augment(cloud, with, b)};
+}
+
 TEST(Augment, ConfusedSectionsOffKeepTheRecipeBeforeThem) {
-  const EnrichedCloud cloud = randomCloud(1000, 9);
   AugmentConfig with;
   with.confused_section_probability = 1.0;
-  std::mt19937 a(9), b(9);
-  const EnrichedCloud off = augment(cloud, AugmentConfig{}, a);
-  const EnrichedCloud on = augment(cloud, with, b);
+  const auto [off, on] = augmentedOffAndOn(with, 9);
   ASSERT_EQ(off.size(), on.size()) << "the section is relabelled after the geometry";
   size_t differ = 0;
   for (size_t i = 0; i < off.size(); ++i) {
@@ -238,12 +243,9 @@ TEST(Augment, ModalityDropoutTakesAllColourOrAllClassesOfAnObservation) {
 }
 
 TEST(Augment, ModalityDropoutOffKeepsTheRecipeBeforeIt) {
-  const EnrichedCloud cloud = randomCloud(1000, 11);
   AugmentConfig with;
   with.modality_dropout_probability = 1.0;
-  std::mt19937 a(11), b(11);
-  const EnrichedCloud off = augment(cloud, AugmentConfig{}, a);
-  const EnrichedCloud on = augment(cloud, with, b);
+  const auto [off, on] = augmentedOffAndOn(with, 11);
   ASSERT_EQ(off.size(), on.size());
   for (size_t i = 0; i < off.size(); ++i) {
     EXPECT_EQ(off[i].x, on[i].x) << "the same draws up to the dropout";
