@@ -155,14 +155,11 @@ TrainConfig trainConfig(const CliArgs& a) {
     config.augmentation.confused_section_probability = probability(a, "confused-sections");
   if (a.has("modality-dropout"))
     config.augmentation.modality_dropout_probability = probability(a, "modality-dropout");
-  if (a.has("lidar-only") || a.has("modality-dropout")) {
-    if (config.net.kind != DescriptorKind::kSemSegMapNet)
-      throw UsageError(std::string("--") +
-                       (a.has("lidar-only") ? "lidar-only" : "modality-dropout") +
-                       ": only semsegmap-net sees colour and classes");
-    if (a.has("lidar-only") && a.has("modality-dropout"))
-      throw UsageError("--modality-dropout: a --lidar-only network sees neither modality anyway");
-  }
+  for (const char* option : {"lidar-only", "modality-dropout"})
+    if (a.has(option) && config.net.kind != DescriptorKind::kSemSegMapNet)
+      throw UsageError(std::string("--") + option + ": only semsegmap-net sees colour and classes");
+  if (a.has("lidar-only") && a.has("modality-dropout"))
+    throw UsageError("--modality-dropout: a --lidar-only network sees neither modality anyway");
   if (a.has("lidar-only")) config.net.use_color = config.net.use_classes = false;
   validateNetConfig(config.net);  // before the long extraction, not after it
   return config;

@@ -201,7 +201,7 @@ EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, s
     out = confuseSection(out, uniform(rng, 0.0, config.max_confused_fraction), rng);
   if (config.modality_dropout_probability > 0) {
     std::bernoulli_distribution dropped(config.modality_dropout_probability);
-    const bool drop_color = dropped(rng);
+    const bool drop_color = dropped(rng);  // drawn first: argument order is unspecified
     out = dropModalities(out, drop_color, dropped(rng));
   }
   return out;
