@@ -30,7 +30,8 @@ DescriptorChoice chooseDescriptor(const DescriptorConfig& descriptor,
     out.note =
         "the input has no colour and no classes, and the configuration names no "
         "descriptor.model_lidar_only: " +
-        descriptor.model + " describes geometry alone, as it was not trained to";
+        descriptor.model +
+        " describes geometry alone (a colour model sees every point grey and of class unknown)";
   }
   return out;
 }
