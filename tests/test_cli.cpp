@@ -99,9 +99,26 @@ const std::vector<CommandOptions> kAllCommands = {
      {"dataset", "rig", "ground-truth", "kitti-calib", "out", "config", "max-frames"},
      {"map", "poses", "odometry"}},
     {"train",
-     {"descriptor", "dataset", "out", "epochs", "batch", "threads", "config", "max-frames", "cache",
-      "anchors-per-epoch", "lr", "seed", "confused-sections", "modality-dropout", "lidar-only",
-      "points", "history"},
+     {"descriptor",
+      "dataset",
+      "out",
+      "epochs",
+      "batch",
+      "threads",
+      "config",
+      "max-frames",
+      "cache",
+      "anchors-per-epoch",
+      "lr",
+      "seed",
+      "confused-sections",
+      "modality-dropout",
+      "lidar-only",
+      "teacher",
+      "distillation-weight",
+      "from-scratch",
+      "points",
+      "history"},
      {"world-seed", "map"}},
     {"demo", {"out", "world-seed", "preset", "max-frames"}, {"configs", "dataset"}},
     {"eval segmentation",
@@ -416,6 +433,38 @@ TEST(Cli, RuntimeErrorsExitOne) {
   EXPECT_EQ(r.err.rfind("semsegmap localize: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("missing.map"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("usage error"), std::string::npos);
+}
+
+// A teacher is checked before the extraction (here the dataset does not even exist): the options
+// that need it, its file and its kind.
+TEST(Cli, TrainChecksItsTeacherBeforeExtracting) {
+  if (!built("train")) GTEST_SKIP() << "this build has no train (SEMSEGMAP_WITH_TORCH=OFF)";
+  TempDir tmp;
+  const std::string train =
+      "train --dataset sim:nowhere --out " + (tmp.path() / "m.model").string() + " ";
+  const Result weight = run(train + "--descriptor semsegmap-net --distillation-weight 2");
+  EXPECT_EQ(weight.code, 2);
+  EXPECT_NE(weight.err.find("--distillation-weight: only with --teacher"), std::string::npos)
+      << weight.err;
+  const Result dropout = run(train +
+                             "--descriptor semsegmap-net --teacher models/semsegmap-net.model "
+                             "--modality-dropout 0.3");
+  EXPECT_EQ(dropout.code, 2);
+  EXPECT_NE(dropout.err.find("the teacher would see the same dropped observation"),
+            std::string::npos)
+      << dropout.err;
+  const Result missing =
+      run(train + "--descriptor semsegmap-net --teacher " + (tmp.path() / "none.model").string());
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("none.model"), std::string::npos) << missing.err;
+  const Result kind =
+      run(train + "--descriptor segmap-cnn --teacher models/semsegmap-net.model --lidar-only");
+  EXPECT_EQ(kind.code, 2) << "--lidar-only is semsegmap-net's";
+  const Result other = run(train + "--descriptor segmap-cnn --teacher models/semsegmap-net.model");
+  EXPECT_EQ(other.code, 1);
+  EXPECT_NE(other.err.find("semsegmap-net.model"), std::string::npos) << other.err;
+  EXPECT_EQ(other.err.find("extract"), std::string::npos) << other.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp.path() / "m.model"));
 }
 
 // A dataset without odometry (here a folder of scans, no pose file) is refused before any frame

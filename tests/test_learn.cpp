@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <set>
 
 #include "semsegmap/datasets/dataset_specs.h"
@@ -562,6 +563,84 @@ TEST_F(SimulatedData, TrainingIsDeterministicForASeedAndKeepsTheBestEpoch) {
       validationAccuracy(*a.net, *data_, split.validation, config.seed,
                          config.max_validation_queries, config.validation_min_completeness);
   EXPECT_EQ(again.top1, best_top1);
+}
+
+// Distillation: the mean squared distance between a LiDAR-only network's descriptors of grey
+// observations and the teacher's of the same observations in colour.
+double distanceToTeacher(DescriptorNetImpl& student, DescriptorNetImpl& teacher,
+                         const TrainingSet& set) {
+  std::vector<size_t> all(set.observations.size());
+  std::iota(all.begin(), all.end(), size_t{0});
+  const Eigen::MatrixXf s = describeObservations(student, set, all, 5);
+  const Eigen::MatrixXf t = describeObservations(teacher, set, all, 5);
+  return (s - t).rowwise().squaredNorm().mean();
+}
+
+TEST_F(SimulatedData, DistillationPullsALidarOnlyStudentTowardsItsColourTeacher) {
+  TrainConfig teaching = tinyTraining();
+  const std::shared_ptr<DescriptorNetImpl> teacher = trainDescriptor(*data_, teaching).net;
+  const std::string teacher_before = netFingerprint(*teacher);
+
+  TrainConfig student = tinyTraining();
+  student.net.use_color = student.net.use_classes = false;
+  student.epochs = 6;
+  student.validation_fraction = 0.0;  // the best epoch is the one of lowest loss
+  student.seed = 7;                   // other initial weights than the teacher's
+  student.start_from_teacher = false;
+  student.distillation_weight = 50.0;
+  const TrainResult distilled = trainDescriptor(*data_, student, {}, teacher);
+  const TrainResult alone = trainDescriptor(*data_, student);
+  EXPECT_EQ(netFingerprint(*teacher), teacher_before) << "the teacher is never trained";
+  for (const EpochStats& e : distilled.history) EXPECT_GT(e.distillation_loss, 0.0);
+  for (const EpochStats& e : alone.history) EXPECT_EQ(e.distillation_loss, 0.0);
+  EXPECT_LT(distilled.history.back().distillation_loss,
+            distilled.history.front().distillation_loss);
+  const double with = distanceToTeacher(*distilled.net, *teacher, *data_);
+  const double without = distanceToTeacher(*alone.net, *teacher, *data_);
+  EXPECT_LT(with, 0.25 * without) << "with " << with << ", without " << without;
+}
+
+// Starting from the teacher: a LiDAR-only student that has not moved describes a grey
+// observation as its teacher describes that observation without colour and classes.
+TEST_F(SimulatedData, AStudentStartsFromItsTeachersWeights) {
+  TrainConfig teaching = tinyTraining();
+  teaching.epochs = 1;
+  const std::shared_ptr<DescriptorNetImpl> teacher = trainDescriptor(*data_, teaching).net;
+  TrainConfig student = tinyTraining();
+  student.net.use_color = student.net.use_classes = false;
+  student.epochs = 1;
+  student.learning_rate = 1e-30;  // Adam's steps are of the learning rate's size: none
+  const TrainResult result = trainDescriptor(*data_, student, {}, teacher);
+
+  // As dropModalities leaves them, so that both networks get the very same input.
+  TrainingSet grey = *data_;
+  for (TrainingObservation& o : grey.observations)
+    for (size_t i = 0; i < o.size(); ++i) {
+      std::fill_n(o.xyzhsv.begin() + static_cast<std::ptrdiff_t>(6 * i + 3), 3, 0.0f);
+      o.classes[i] = cls::kUnknown;
+      o.colored[i] = 0;
+    }
+  const std::vector<size_t> some = {0, 5, 10};
+  const Eigen::MatrixXf s = describeObservations(*result.net, grey, some, 3);
+  const Eigen::MatrixXf t = describeObservations(*teacher, grey, some, 3);
+  EXPECT_GT(t.cwiseAbs().maxCoeff(), 1e-3f);
+  EXPECT_LT((s - t).cwiseAbs().maxCoeff(), 1e-4f);
+}
+
+TEST_F(SimulatedData, ATeacherOfAnotherKindOrSizeIsRefused) {
+  TrainConfig config = tinyTraining();
+  config.net.kind = DescriptorKind::kSegMapCnn;
+  const auto cnn = makeNet(config.net);
+  config.net.kind = DescriptorKind::kSemSegMapNet;
+  EXPECT_THROW(trainDescriptor(*data_, config, {}, cnn), std::invalid_argument);
+  TrainConfig wider = config;
+  wider.net.descriptor_dim = 32;
+  EXPECT_THROW(trainDescriptor(*data_, config, {}, makeNet(wider.net)), std::invalid_argument);
+  wider.net.descriptor_dim = config.net.descriptor_dim;
+  wider.net.pointnet_width = 16;  // the same descriptors from other weights: nothing to start from
+  EXPECT_THROW(trainDescriptor(*data_, config, {}, makeNet(wider.net)), std::invalid_argument);
+  config.distillation_weight = -1;
+  EXPECT_THROW(trainDescriptor(*data_, config, {}, makeNet(config.net)), std::invalid_argument);
 }
 
 TEST(Trainer, RejectsBadConfigurations) {

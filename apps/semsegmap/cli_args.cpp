@@ -62,6 +62,10 @@ void checkValue(const OptionSpec& option, const std::string& text) {
       if (!parseNumber(text, &x) || !(x > 0))
         throw UsageError(what + " expects a positive number" + got);
       break;
+    case Value::kWeight:
+      if (!parseNumber(text, &x) || !(x >= 0))
+        throw UsageError(what + " expects a number >= 0" + got);
+      break;
     case Value::kFlag:
     case Value::kText:
       break;

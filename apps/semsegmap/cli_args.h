@@ -27,6 +27,7 @@ enum class Value {
   kCount,     // an integer >= 0
   kPositive,  // an integer >= 1
   kNumber,    // a number > 0
+  kWeight,    // a number >= 0
 };
 
 constexpr bool kRequired = true;

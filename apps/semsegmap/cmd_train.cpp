@@ -78,7 +78,8 @@ TrainingSet loadOrExtract(const std::vector<std::string>& specs, const PipelineC
 // on a terminal, a line every tenth of an epoch or 30 s into a log).
 class EpochProgress {
  public:
-  explicit EpochProgress(int epochs) : epochs_(epochs), start_(std::chrono::steady_clock::now()) {}
+  EpochProgress(int epochs, bool distilled)
+      : epochs_(epochs), distilled_(distilled), start_(std::chrono::steady_clock::now()) {}
 
   void step(int epoch, size_t done, size_t total, double loss) {
     if (epoch != epoch_) {
@@ -101,10 +102,13 @@ class EpochProgress {
     std::snprintf(text, sizeof text, "val top1 %.3f top5 %.3f", s.validation.top1,
                   s.validation.top5);
     validation_ = text;
+    char distillation[48] = "";
+    if (distilled_)
+      std::snprintf(distillation, sizeof distillation, ", distillation %.4f", s.distillation_loss);
     std::printf(
-        "epoch %d  loss %.4f (triplet %.4f, reconstruction %.4f)  val top1 %.3f top5 %.3f "
+        "epoch %d  loss %.4f (triplet %.4f, reconstruction %.4f%s)  val top1 %.3f top5 %.3f "
         "(%zu queries)  %.0f s%s\n",
-        s.epoch, s.loss, s.triplet_loss, s.reconstruction_loss, s.validation.top1,
+        s.epoch, s.loss, s.triplet_loss, s.reconstruction_loss, distillation, s.validation.top1,
         s.validation.top5, s.validation.queries, s.seconds, s.best ? "  best" : "");
     std::fflush(stdout);
   }
@@ -114,6 +118,7 @@ class EpochProgress {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
   int epochs_;
+  bool distilled_;
   std::chrono::steady_clock::time_point start_;
   int epoch_ = 0;
   ProgressLine line_;
@@ -123,12 +128,13 @@ class EpochProgress {
 // One row per epoch, for the model card.
 void writeHistoryCsv(const std::filesystem::path& path, const std::vector<EpochStats>& history) {
   writeFileAtomically(path, [&](std::ostream& out) {
-    out << "epoch,loss,triplet_loss,reconstruction_loss,val_top1,val_top5,val_queries,"
-           "learning_rate,seconds,best\n";
+    out << "epoch,loss,triplet_loss,reconstruction_loss,distillation_loss,val_top1,val_top5,"
+           "val_queries,learning_rate,seconds,best\n";
     for (const EpochStats& e : history)
       out << e.epoch << ',' << e.loss << ',' << e.triplet_loss << ',' << e.reconstruction_loss
-          << ',' << e.validation.top1 << ',' << e.validation.top5 << ',' << e.validation.queries
-          << ',' << e.learning_rate << ',' << e.seconds << ',' << (e.best ? 1 : 0) << '\n';
+          << ',' << e.distillation_loss << ',' << e.validation.top1 << ',' << e.validation.top5
+          << ',' << e.validation.queries << ',' << e.learning_rate << ',' << e.seconds << ','
+          << (e.best ? 1 : 0) << '\n';
   });
 }
 
@@ -161,12 +167,42 @@ TrainConfig trainConfig(const CliArgs& a) {
   if (a.has("lidar-only") && a.has("modality-dropout"))
     throw UsageError("--modality-dropout: a --lidar-only network sees neither modality anyway");
   if (a.has("lidar-only")) config.net.use_color = config.net.use_classes = false;
+  for (const char* option : {"distillation-weight", "from-scratch"})
+    if (a.has(option) && !a.has("teacher"))
+      throw UsageError(std::string("--") + option + ": only with --teacher");
+  // The teacher would see what the dropout took from the student, and teach it nothing.
+  if (a.has("teacher") && a.has("modality-dropout"))
+    throw UsageError("--modality-dropout: the teacher would see the same dropped observation");
+  if (a.has("distillation-weight")) {
+    config.distillation_weight = a.getNumber("distillation-weight");
+    if (!(config.distillation_weight >= 0 && config.distillation_weight <= 1e6))
+      throw UsageError("--distillation-weight: " + a.get("distillation-weight") +
+                       " is not in [0, 1e6]");
+  }
+  config.start_from_teacher = !a.has("from-scratch");
   validateNetConfig(config.net);  // before the long extraction, not after it
   return config;
 }
 
+// The teacher, read and checked against the student before the long extraction.
+std::shared_ptr<DescriptorNetImpl> loadTeacher(const CliArgs& a, const TrainConfig& config) {
+  if (!a.has("teacher")) return nullptr;
+  auto teacher = loadNet(a.get("teacher"), config.net.kind);
+  const NetConfig& t = teacher->config();
+  if (t.descriptor_dim != config.net.descriptor_dim)
+    throw std::runtime_error(a.get("teacher") + ": descriptors of " +
+                             std::to_string(t.descriptor_dim) + " values, the student's have " +
+                             std::to_string(config.net.descriptor_dim));
+  std::cout << "distilling from " << a.get("teacher") << " (fingerprint "
+            << netFingerprint(*teacher) << ", weight " << config.distillation_weight
+            << "), starting from " << (config.start_from_teacher ? "its weights" : "fresh weights")
+            << "\n";
+  return teacher;
+}
+
 int runTrain(const CliArgs& a) {
   const TrainConfig config = trainConfig(a);
+  const auto teacher = loadTeacher(a, config);
   const std::vector<std::string> specs = splitDatasetSpecs(a.get("dataset"));
   const std::filesystem::path out = a.get("out");
   ExtractionConfig extraction;
@@ -182,7 +218,7 @@ int runTrain(const CliArgs& a) {
 
   const TrainingSet data =
       loadOrExtract(specs, pipeline, config_text, extraction, a.has("cache") ? a.get("cache") : "");
-  EpochProgress progress(config.epochs);
+  EpochProgress progress(config.epochs, teacher != nullptr);
   TrainCallbacks callbacks;
   callbacks.step = [&](int epoch, size_t done, size_t total, double loss) {
     progress.step(epoch, done, total, loss);
@@ -196,7 +232,7 @@ int runTrain(const CliArgs& a) {
     progress.epoch(s);
   };
   callbacks.best = [&](DescriptorNetImpl& net) { saveNet(out, net); };
-  const TrainResult result = trainDescriptor(data, config, callbacks);
+  const TrainResult result = trainDescriptor(data, config, callbacks, teacher);
 
   if (a.has("history")) std::cout << "wrote " << a.get("history") << "\n";
   std::printf("trained on %zu observations (%zu anchors), validated on %zu\n",
@@ -268,6 +304,16 @@ const CommandSpec& trainCommand() {
           {"lidar-only", Value::kFlag, "", "",
            "the network sees geometry only (no colour, no classes): the model for a LiDAR "
            "without a camera (descriptor.model_lidar_only)"},
+          {"teacher", Value::kText, "FILE", "",
+           "distil a trained model of the same descriptor: the student is also pulled towards "
+           "its descriptor of each observation, which it sees with colour and classes (with "
+           "--lidar-only, the student learns from geometry what the teacher knows with them)"},
+          {"distillation-weight", Value::kWeight, "X", "",
+           "weight of the distillation's mean squared descriptor distance against the triplet "
+           "loss; 0: the teacher only gives the starting weights " +
+               shown([](const TrainConfig& c) { return c.distillation_weight; })},
+          {"from-scratch", Value::kFlag, "", "",
+           "with --teacher, start from fresh weights instead of the teacher's"},
           {"points", Value::kPositive, "N", "",
            "points a segment is subsampled to " +
                shown([](const TrainConfig& c) { return c.net.num_points; })},

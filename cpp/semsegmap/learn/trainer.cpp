@@ -29,6 +29,43 @@ void checkConfig(const TrainConfig& c) {
   if (!(c.validation_fraction >= 0 && c.validation_fraction < 1))
     fail("validation fraction must be in [0, 1)");
   if (!(c.max_sigma > 0)) fail("max sigma must be positive");
+  if (!(c.distillation_weight >= 0 && std::isfinite(c.distillation_weight)))
+    fail("distillation weight must be finite and not negative");
+}
+
+// A teacher must describe in the student's space: the same kind of network and descriptor size.
+// With start_from_teacher the student takes its weights, so they must match by name and shape
+// (the modalities a network sees change its input, not its weights).
+void checkTeacher(const TrainConfig& c, DescriptorNetImpl& teacher) {
+  const NetConfig& t = teacher.config();
+  auto fail = [](const std::string& what) { throw std::invalid_argument("teacher: " + what); };
+  if (t.kind != c.net.kind)
+    fail("a " + descriptorName(t.kind) + " cannot teach a " + descriptorName(c.net.kind));
+  if (t.descriptor_dim != c.net.descriptor_dim)
+    fail("descriptor size " + std::to_string(t.descriptor_dim) + ", the student's is " +
+         std::to_string(c.net.descriptor_dim));
+}
+
+// The student's initial weights: the teacher's, tensor by tensor.
+void copyWeights(DescriptorNetImpl& from, DescriptorNetImpl& to) {
+  auto tensors = [](DescriptorNetImpl& net) {
+    std::vector<std::pair<std::string, torch::Tensor>> out;
+    for (const auto& p : net.named_parameters()) out.emplace_back(p.key(), p.value());
+    for (const auto& b : net.named_buffers()) out.emplace_back(b.key(), b.value());
+    return out;
+  };
+  const auto source = tensors(from), target = tensors(to);
+  if (source.size() != target.size())
+    throw std::invalid_argument("teacher: its weights do not fit the student (" +
+                                std::to_string(source.size()) + " tensors, the student has " +
+                                std::to_string(target.size()) + ")");
+  torch::NoGradGuard no_grad;
+  for (size_t i = 0; i < source.size(); ++i) {
+    if (source[i].first != target[i].first || source[i].second.sizes() != target[i].second.sizes())
+      throw std::invalid_argument("teacher: its weights do not fit the student (" +
+                                  source[i].first + " against " + target[i].first + ")");
+    target[i].second.copy_(source[i].second);
+  }
 }
 
 // Copies of the weights of the best epoch, so that the result does not depend on a file.
@@ -57,14 +94,31 @@ struct Mean {
 
 struct BatchLoss {
   torch::Tensor triplet, reconstruction;
-  torch::Tensor descriptors;  // [3B, D]: anchors, positives, negatives
+  torch::Tensor distillation;  // 0 without a teacher
+  torch::Tensor descriptors;   // [3B, D]: anchors, positives, negatives
 };
+
+// The mean squared distance between the student's descriptors `d` and the teacher's of the same
+// clouds, which the teacher sees with everything it was trained on (a LiDAR-only student's
+// clouds still carry their colour and classes: only the student's input leaves them out).
+torch::Tensor distillationLoss(DescriptorNetImpl& teacher, const std::vector<EnrichedCloud>& clouds,
+                               const torch::Tensor& d, std::mt19937& rng) {
+  std::vector<const EnrichedCloud*> all;
+  for (const auto& c : clouds) all.push_back(&c);
+  torch::Tensor target;
+  {
+    torch::NoGradGuard no_grad;
+    target = teacher.encode(makeNetInput(teacher.config(), all, rng));
+  }
+  return (d - target).pow(2).sum(1).mean();
+}
 
 // The loss of one batch of triplets. Only (some of) the anchors are decoded: the decoder costs
 // more than the encoder (twice as much for semsegmap-net, twenty times for segmap-cnn), and the
 // loss reconstructs the anchor.
 BatchLoss batchLoss(DescriptorNetImpl& net, const TrainingSet& data, const std::vector<Triplet>& t,
-                    const TrainConfig& config, bool augmented, std::mt19937& rng) {
+                    const TrainConfig& config, bool augmented, std::mt19937& rng,
+                    DescriptorNetImpl* teacher = nullptr) {
   const size_t batch = t.size();
   std::vector<EnrichedCloud> clouds;
   clouds.reserve(3 * batch);
@@ -102,6 +156,7 @@ BatchLoss batchLoss(DescriptorNetImpl& net, const TrainingSet& data, const std::
                   torch::from_blob(sigma.data(), {B}, torch::kFloat).clone(), config.margin);
   loss.reconstruction = torch::binary_cross_entropy_with_logits(decoded_output.reconstruction,
                                                                 decoded_input.target_occupancy);
+  loss.distillation = teacher ? distillationLoss(*teacher, clouds, d, rng) : torch::zeros({});
   loss.descriptors = d;
   return loss;
 }
@@ -239,18 +294,20 @@ class DescriptorCache {
 class Training {
  public:
   Training(const TrainingSet& data, const TrainConfig& config, const TrainValSplit& split,
-           const PairSampler& sampler)
+           const PairSampler& sampler, std::shared_ptr<DescriptorNetImpl> teacher)
       : data_(data),
         config_(config),
         split_(split),
         sampler_(sampler),
         rng_(static_cast<uint32_t>(config.seed)),
-        net_(makeNet(config.net)),
+        net_(studentNet(config, teacher.get())),
+        teacher_(std::move(teacher)),
         optimizer_(net_->parameters(), torch::optim::AdamOptions(config.learning_rate)),
         cache_(data.observations.size(), config.net.descriptor_dim),
         batch_(std::min<size_t>(static_cast<size_t>(config.batch_size), sampler.anchors().size())),
         learning_rate_(config.learning_rate) {
     net_->train();
+    if (teacher_) teacher_->eval();
     const size_t anchors_per_epoch =
         config.anchors_per_epoch > 0 ? config.anchors_per_epoch : sampler.anchors().size();
     steps_ = std::max<size_t>(1, anchors_per_epoch / batch_);
@@ -259,11 +316,15 @@ class Training {
   EpochStats epoch(int epoch, const TrainCallbacks& callbacks) {
     const auto t0 = std::chrono::steady_clock::now();
     const bool mine = epoch > config_.warmup_epochs;
-    Mean loss_mean, triplet_mean, recon_mean;
+    Mean loss_mean, triplet_mean, recon_mean, distillation_mean;
     for (size_t step = 0; step < steps_; ++step) {
       const std::vector<Triplet> triplets = sampleTriplets(mine);
-      const BatchLoss b = batchLoss(*net_, data_, triplets, config_, config_.augment, rng_);
-      const torch::Tensor loss = b.triplet + config_.reconstruction_weight * b.reconstruction;
+      // A teacher of weight 0 only gave the starting weights: its descriptors are not needed.
+      DescriptorNetImpl* teacher = config_.distillation_weight > 0 ? teacher_.get() : nullptr;
+      const BatchLoss b =
+          batchLoss(*net_, data_, triplets, config_, config_.augment, rng_, teacher);
+      torch::Tensor loss = b.triplet + config_.reconstruction_weight * b.reconstruction;
+      if (teacher) loss = loss + config_.distillation_weight * b.distillation;
       optimizer_.zero_grad();
       loss.backward();
       optimizer_.step();
@@ -271,6 +332,7 @@ class Training {
       loss_mean.add(loss.item<double>());
       triplet_mean.add(b.triplet.item<double>());
       recon_mean.add(b.reconstruction.item<double>());
+      distillation_mean.add(b.distillation.item<double>());
       if (callbacks.step) callbacks.step(epoch, step + 1, steps_, loss_mean.value());
     }
     EpochStats stats;
@@ -278,6 +340,7 @@ class Training {
     stats.loss = loss_mean.value();
     stats.triplet_loss = triplet_mean.value();
     stats.reconstruction_loss = recon_mean.value();
+    stats.distillation_loss = distillation_mean.value();
     stats.learning_rate = learning_rate_;
     stats.validation =
         validationAccuracy(*net_, data_, split_.validation, config_.seed,
@@ -326,7 +389,16 @@ class Training {
   const TrainValSplit& split_;
   const PairSampler& sampler_;
   std::mt19937 rng_;
+  // Fresh weights (torch's seeded RNG), or the teacher's to start from.
+  static std::shared_ptr<DescriptorNetImpl> studentNet(const TrainConfig& config,
+                                                       DescriptorNetImpl* teacher) {
+    auto net = makeNet(config.net);
+    if (teacher && config.start_from_teacher) copyWeights(*teacher, *net);
+    return net;
+  }
+
   std::shared_ptr<DescriptorNetImpl> net_;
+  std::shared_ptr<DescriptorNetImpl> teacher_;  // null without distillation; never trained
   torch::optim::Adam optimizer_;
   DescriptorCache cache_;
   size_t batch_, steps_ = 1;
@@ -337,8 +409,10 @@ class Training {
 }  // namespace
 
 TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
-                            const TrainCallbacks& callbacks) {
+                            const TrainCallbacks& callbacks,
+                            std::shared_ptr<DescriptorNetImpl> teacher) {
   checkConfig(config);
+  if (teacher) checkTeacher(config, *teacher);
   torch::set_num_threads(config.threads);
   torch::manual_seed(config.seed);
 
@@ -352,7 +426,7 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
     throw std::runtime_error(
         "training data has no instance observed twice: nothing to learn from (more frames?)");
 
-  Training training(data, config, split, sampler);
+  Training training(data, config, split, sampler, std::move(teacher));
   Snapshot best;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int epoch = 1; epoch <= config.epochs; ++epoch) {

@@ -49,6 +49,15 @@ struct TrainConfig {
   uint64_t seed = 1;  // weights, sampling, augmentation: the same seed gives the same model
   bool augment = true;
   AugmentConfig augmentation;
+  // Distillation (used when trainDescriptor is given a teacher): the student is also pulled
+  // towards the teacher's descriptor of the very observation it sees, weighted by this against
+  // the triplet loss (the mean squared distance of the two 64-d descriptors). A LiDAR-only
+  // student so learns from a colour-trained teacher what the teacher knows with colour and
+  // classes, which the triplet loss on grey points alone does not teach it.
+  double distillation_weight = 1.0;
+  // The student starts from the teacher's weights (the same network; a LiDAR-only student then
+  // starts as the teacher sees grey points) rather than from fresh ones.
+  bool start_from_teacher = true;
 };
 
 // The recipe of the shipped models for `kind`: sized to train in well under 90 minutes on two
@@ -58,6 +67,7 @@ TrainConfig defaultTrainConfig(DescriptorKind kind);
 struct EpochStats {
   int epoch = 0;                                                     // from 1
   double loss = 0.0, triplet_loss = 0.0, reconstruction_loss = 0.0;  // means over the epoch
+  double distillation_loss = 0.0;                                    // 0 without a teacher
   RetrievalAccuracy validation;
   double learning_rate = 0.0;
   double seconds = 0.0;  // training and validation
@@ -80,10 +90,13 @@ struct TrainCallbacks {
 };
 
 // Trains a new network on `data`. The best epoch is the one of highest validation top-1 (the
-// lowest training loss when the validation half has no query). Throws std::invalid_argument on a
-// bad config and std::runtime_error when the data has no instance seen twice.
+// lowest training loss when the validation half has no query). With a `teacher` (a trained
+// network of the same kind and descriptor size, left unchanged), the loss also holds the
+// distillation term of config.distillation_weight. Throws std::invalid_argument on a bad config
+// or a teacher that does not fit and std::runtime_error when the data has no instance seen twice.
 TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
-                            const TrainCallbacks& callbacks = {});
+                            const TrainCallbacks& callbacks = {},
+                            std::shared_ptr<DescriptorNetImpl> teacher = nullptr);
 
 // Descriptors (one row each) of data.observations[which[i]], unaugmented, in eval mode; the
 // subsampling of the points is seeded by `seed`.
