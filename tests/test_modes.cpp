@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <random>
@@ -92,6 +93,49 @@ TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {
        {"n_localizations", "n_error_below_1m", "n_error_below_5m", "mean_translation_error_m",
         "mean_rotation_error_deg", "fps", "stage_ms", "map_segments", "map_bytes"})
     EXPECT_NE(json.find(std::string("\"") + key + "\""), std::string::npos) << key;
+}
+
+// target_map.earlier_observations_apart_m: the map holds every final observation it holds
+// without, and besides them earlier observations of the same segments, each at least that far
+// from its segment's final one (the oracle describes an instance the same in every observation).
+TEST(Modes, AMapKeepsEarlierObservationsApartFromTheFinalOnes) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  PipelineConfig config = semsegmapConfig();
+  config.target_map.duplicate_distance_m = 0;  // every entry stays: compare them one by one
+  const auto oracle = std::make_shared<OracleDescriber>();
+  auto mapping = openDataset("sim:world=1,run=S2,preset=tiny,frames=60");
+  const TargetMap final_only = runMapping(*mapping, config, PoseSource::kGroundTruth, oracle).map;
+  config.target_map.earlier_observations_apart_m = 1.0;
+  const MappingRun run = runMapping(*mapping, config, PoseSource::kGroundTruth, oracle);
+  const TargetMap& with = run.map;
+  ASSERT_GT(with.size(), final_only.size());
+  auto rowOf = [](const TargetMap& map, size_t i) {
+    return Eigen::VectorXf(map.descriptors.row(static_cast<Eigen::Index>(i)).transpose());
+  };
+  std::vector<bool> final(with.size(), false);
+  for (size_t i = 0; i < final_only.size(); ++i) {
+    bool found = false;
+    for (size_t j = 0; j < with.size() && !found; ++j)
+      if ((with.segments[j].centroid - final_only.segments[i].centroid).norm() < 1e-6f &&
+          rowOf(with, j) == rowOf(final_only, i))
+        found = final[j] = true;
+    EXPECT_TRUE(found) << "final observation " << i << " is missing";
+  }
+  size_t earlier = 0, apart = 0;
+  for (size_t j = 0; j < with.size(); ++j) {
+    if (final[j]) continue;
+    ++earlier;
+    // Its instance's final observations (a segment may have merged with another since).
+    float nearest = std::numeric_limits<float>::infinity();
+    for (size_t i = 0; i < with.size(); ++i)
+      if (final[i] && rowOf(with, i) == rowOf(with, j))
+        nearest = std::min(nearest, (with.segments[i].centroid - with.segments[j].centroid).norm());
+    apart += nearest >= 1.0f;
+  }
+  EXPECT_EQ(earlier, with.size() - final_only.size());
+  EXPECT_EQ(run.earlier_observations, earlier);
+  EXPECT_EQ(run.duplicates_removed, 0u);
+  EXPECT_GE(apart, earlier * 8 / 10) << "of " << earlier << " earlier observations";
 }
 
 // A run that localized nothing has no mean error: null, never a 0 that reads as perfect.

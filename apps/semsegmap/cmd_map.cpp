@@ -40,7 +40,7 @@ int runMap(const CliArgs& a) {
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   TargetMap map;
   RunStats stats;
-  size_t segments = 0, duplicates = 0;
+  size_t segments = 0, earlier = 0, duplicates = 0;
   if (poses == "slam") {
     SlamRun run = runSlam(*source, config, describer, options);
     map = std::move(run.map);
@@ -51,16 +51,20 @@ int runMap(const CliArgs& a) {
     map = std::move(run.map);
     stats = run.stats;
     segments = run.segments;
+    earlier = run.earlier_observations;
     duplicates = run.duplicates_removed;
   }
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
   MapWriteOptions write;
   write.float16 = !a.has("float32");
   const uint64_t bytes = saveTargetMap(out, map, write);
+  const std::string kept =
+      earlier ? " + " + std::to_string(earlier) + " earlier observations of them" : "";
   std::printf(
-      "frames %zu  segments %zu (%zu duplicates removed)  map %zu segments, %llu bytes "
+      "frames %zu  segments %zu%s (%zu duplicates removed)  map %zu segments, %llu bytes "
       "(%.1f bytes/segment)  pipeline %.1f Hz\n",
-      stats.frames, segments, duplicates, map.size(), static_cast<unsigned long long>(bytes),
+      stats.frames, segments, kept.c_str(), duplicates, map.size(),
+      static_cast<unsigned long long>(bytes),
       map.size() ? static_cast<double>(bytes) / map.size() : 0.0, stats.fps());
   std::cout << "wrote " << out.string() << "\n";
   return 0;

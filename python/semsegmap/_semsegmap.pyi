@@ -234,6 +234,7 @@ class TargetMapBuilderConfig:
     _fields: tuple[str, ...]
     duplicate_distance_m: float
     max_points_per_segment: int
+    earlier_observations_apart_m: float
     def __init__(self, **fields: object) -> None: ...
 
 class PoseGraphConfig:

@@ -86,7 +86,8 @@ void bindLocalizationConfigs(py::module_& m) {
   using TMB = TargetMapBuilderConfig;
   StructBinding<TMB>(m, "TargetMapBuilderConfig", "localize/target_map.h")
       .field("duplicate_distance_m", &TMB::duplicate_distance_m)
-      .field("max_points_per_segment", &TMB::max_points_per_segment);
+      .field("max_points_per_segment", &TMB::max_points_per_segment)
+      .field("earlier_observations_apart_m", &TMB::earlier_observations_apart_m);
   StructBinding<PoseGraphConfig>(m, "PoseGraphConfig", "graph/pose_graph.h")
       .field("odometry_translation_sigma_m", &PoseGraphConfig::odometry_translation_sigma_m)
       .field("odometry_rotation_sigma_rad", &PoseGraphConfig::odometry_rotation_sigma_rad)

@@ -184,6 +184,9 @@ void checkPipelineConfig(const std::filesystem::path& path, const PipelineConfig
   check(loc.every_n_frames >= 1, "localization.every_n_frames: must be at least 1");
   check(c.target_map.duplicate_distance_m >= 0,
         "target_map.duplicate_distance_m: must not be negative");
+  check(c.target_map.earlier_observations_apart_m >= 0 &&
+            c.target_map.earlier_observations_apart_m <= 1000,
+        "target_map.earlier_observations_apart_m: must be in [0, 1000]");
   const auto& rf = loc.refinement;
   check(rf.max_points_per_segment >= 1, "refinement.max_points_per_segment: must be at least 1");
   check(rf.fine_distance_m > 0 && rf.coarse_distance_m >= rf.fine_distance_m,
@@ -371,7 +374,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
   readSection(path, root, "target_map",
               {{"duplicate_distance_m", set(c.target_map.duplicate_distance_m)},
                // The map file stores a segment's point count in 16 bits (io/map_file.cpp).
-               {"max_points_per_segment", count(c.target_map.max_points_per_segment, 0, 65535)}});
+               {"max_points_per_segment", count(c.target_map.max_points_per_segment, 0, 65535)},
+               {"earlier_observations_apart_m", set(c.target_map.earlier_observations_apart_m)}});
   auto& lc = c.loop_closure;
   readSection(path, root, "loop_closure",
               {{"exclude_recent_m", set(lc.exclude_recent_m)},

@@ -46,6 +46,12 @@ struct TargetMapBuilderConfig {
   // duplicates), and the newer one saw at least as much of the place. 0 disables the filter.
   double duplicate_distance_m = 0.5;
   size_t max_points_per_segment = 0;  // points kept per segment for pictures (0: none)
+  // Besides a segment's final observation, a mapping run keeps each earlier one whose centroid
+  // lies at least this far from every other it keeps of that segment (0: the final one alone).
+  // A segment seen from several places is the sum of those views, and a robot that comes back
+  // with fewer of them (sparse scans, a wake-up) sees it as one of the earlier observations did:
+  // its centroid and descriptor match those, not the final one's (README, KITTI 1576).
+  double earlier_observations_apart_m = 0.0;
 };
 
 // Collects finished segments of a mapping run into a target map.

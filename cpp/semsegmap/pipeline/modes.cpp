@@ -46,14 +46,73 @@ MappingSession::MappingSession(const PipelineConfig& config, const DatasetInfo& 
 
 void MappingSession::add(const std::vector<Segment>& segments,
                          const std::vector<Eigen::VectorXf>& d) {
-  for (size_t i = 0; i < segments.size(); ++i)
-    builder_.add(mapSegmentOf(segments[i], config_.target_map.max_points_per_segment), d[i]);
+  const double apart = config_.target_map.earlier_observations_apart_m;
+  for (size_t i = 0; i < segments.size(); ++i) {
+    const MapSegment final = mapSegmentOf(segments[i], config_.target_map.max_points_per_segment);
+    // The earlier observations first: the builder lets a later segment replace an earlier one
+    // nearby, and the final observation is the most complete.
+    if (auto views = earlier_.extract(segments[i].id))
+      for (const KeptObservation& k : views.mapped().kept)
+        if ((k.segment.centroid - final.centroid).norm() >= apart) {
+          builder_.add(k.segment, k.descriptor);
+          ++run_.earlier_observations;
+        }
+    builder_.add(final, d[i]);
+  }
   run_.segments += segments.size();
+}
+
+void MappingSession::keep(std::vector<KeptObservation>& kept, KeptObservation observation) const {
+  const double apart = config_.target_map.earlier_observations_apart_m;
+  if (observation.descriptor.size() == 0) return;  // never described
+  for (const KeptObservation& k : kept)
+    if ((k.segment.centroid - observation.segment.centroid).norm() < apart) return;
+  kept.push_back(std::move(observation));
+}
+
+// A segment's observation is kept when the next one has moved its centroid `apart` from the last
+// kept (or the first): the place as it looked before the views that moved it (with sparse scans,
+// as of one scan), which a robot that comes back with fewer views sees again. A segment absorbed
+// by another hands its views to it, its last observation among them. The observations come as
+// the pipeline described them, so keeping them costs no description.
+void MappingSession::keepEarlierObservations(const FrameResult& r) {
+  const double apart = config_.target_map.earlier_observations_apart_m;
+  if (apart <= 0) return;
+  for (const SegmentMerge& m : r.segmentation.merges) {
+    auto absorbed = earlier_.extract(m.absorbed);
+    if (!absorbed) continue;
+    SegmentViews& survivor = earlier_[m.survivor];
+    for (KeptObservation& k : absorbed.mapped().kept) keep(survivor.kept, std::move(k));
+    keep(survivor.kept, std::move(absorbed.mapped().latest));
+  }
+  const auto& described = pipeline_.localSegments();
+  for (SegmentId id : r.segmentation.observed) {
+    const auto it = described.find(id);
+    if (it == described.end()) continue;  // finished this frame: its final observation goes in
+    const DescribedSegment& e = it->second;
+    const bool first = earlier_.count(id) == 0;
+    SegmentViews& views = earlier_[id];
+    KeptObservation k;
+    k.segment.centroid = e.centroid;
+    k.segment.n_points = e.n_points;
+    k.segment.majority_class = e.majority_class;
+    k.segment.points =
+        subsamplePoints(pipeline_.observedPoints(id), config_.target_map.max_points_per_segment);
+    k.descriptor = e.descriptor;
+    if (first) {
+      views.since = k.segment.centroid;
+    } else if ((k.segment.centroid - views.since).norm() >= apart) {
+      views.since = views.latest.segment.centroid;
+      keep(views.kept, std::move(views.latest));
+    }
+    views.latest = std::move(k);
+  }
 }
 
 void MappingSession::process(const Frame& frame) {
   const FrameResult r = pipeline_.process(frame);
   run_.trajectory.push_back(r.T_local_base);
+  keepEarlierObservations(r);
   add(r.segmentation.finished, r.finished_descriptors);
   run_.stats.total += r.times;
   ++run_.stats.frames;

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "semsegmap/pipeline/map_parameters.h"
@@ -29,9 +30,10 @@ struct RunStats {
 
 struct MappingRun {
   TargetMap map;
-  std::vector<Pose> trajectory;  // the poses the map was built with
-  size_t segments = 0;           // finished segments before removing duplicates
-  size_t duplicates_removed = 0;
+  std::vector<Pose> trajectory;     // the poses the map was built with
+  size_t segments = 0;              // finished segments before removing duplicates
+  size_t earlier_observations = 0;  // kept beside them (target_map.earlier_observations_apart_m)
+  size_t duplicates_removed = 0;    // of either
   RunStats stats;
 };
 
@@ -47,10 +49,24 @@ class MappingSession {
 
  private:
   void add(const std::vector<Segment>& segments, const std::vector<Eigen::VectorXf>& d);
+  void keepEarlierObservations(const FrameResult& r);
+  struct KeptObservation {
+    MapSegment segment;
+    Eigen::VectorXf descriptor;
+  };
+  struct SegmentViews {
+    std::vector<KeptObservation> kept;                // each `apart` from the others
+    KeptObservation latest;                           // the segment's last observation so far
+    Eigen::Vector3f since = Eigen::Vector3f::Zero();  // centroid of the last kept, or the first
+  };
+  void keep(std::vector<KeptObservation>& kept, KeptObservation observation) const;
   PipelineConfig config_;
   Pipeline pipeline_;
   TargetMapBuilder builder_;
   MappingRun run_;
+  // Per segment still in the local map, the earlier observations the map keeps
+  // (target_map.earlier_observations_apart_m).
+  std::unordered_map<SegmentId, SegmentViews> earlier_;
 };
 
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
