@@ -188,11 +188,11 @@ TrainConfig trainConfig(const CliArgs& a) {
 std::shared_ptr<DescriptorNetImpl> loadTeacher(const CliArgs& a, const TrainConfig& config) {
   if (!a.has("teacher")) return nullptr;
   auto teacher = loadNet(a.get("teacher"), config.net.kind);
-  const NetConfig& t = teacher->config();
-  if (t.descriptor_dim != config.net.descriptor_dim)
-    throw std::runtime_error(a.get("teacher") + ": descriptors of " +
-                             std::to_string(t.descriptor_dim) + " values, the student's have " +
-                             std::to_string(config.net.descriptor_dim));
+  try {
+    checkTeacher(config, *teacher);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(a.get("teacher") + ": " + e.what());
+  }
   std::cout << "distilling from " << a.get("teacher") << " (fingerprint "
             << netFingerprint(*teacher) << ", weight " << config.distillation_weight
             << "), starting from " << (config.start_from_teacher ? "its weights" : "fresh weights")

@@ -36,6 +36,8 @@ void checkConfig(const TrainConfig& c) {
 // A teacher must describe in the student's space: the same kind of network and descriptor size.
 // With start_from_teacher the student takes its weights, so they must match by name and shape
 // (the modalities a network sees change its input, not its weights).
+}  // namespace
+
 void checkTeacher(const TrainConfig& c, DescriptorNetImpl& teacher) {
   const NetConfig& t = teacher.config();
   auto fail = [](const std::string& what) { throw std::invalid_argument("teacher: " + what); };
@@ -45,6 +47,8 @@ void checkTeacher(const TrainConfig& c, DescriptorNetImpl& teacher) {
     fail("descriptor size " + std::to_string(t.descriptor_dim) + ", the student's is " +
          std::to_string(c.net.descriptor_dim));
 }
+
+namespace {
 
 // The student's initial weights: the teacher's, tensor by tensor.
 void copyWeights(DescriptorNetImpl& from, DescriptorNetImpl& to) {

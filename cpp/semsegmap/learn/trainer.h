@@ -116,6 +116,10 @@ RetrievalAccuracy validationAccuracy(DescriptorNetImpl& net, const TrainingSet& 
                                      const std::vector<size_t>& which, uint64_t seed,
                                      size_t max_queries = 4000, double min_completeness = 0.5);
 
+// Throws std::invalid_argument "teacher: ..." unless `teacher` describes in the student's space
+// (config.net): the same kind of network and descriptor size.
+void checkTeacher(const TrainConfig& config, DescriptorNetImpl& teacher);
+
 struct Triplet {
   size_t anchor = 0, positive = 0, negative = 0;  // indices into TrainingSet::observations
 };
