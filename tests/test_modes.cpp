@@ -13,6 +13,7 @@
 
 #include "build_options.h"
 #include "semsegmap/core/diagnostics.h"
+#include "semsegmap/core/frame_subset.h"
 #include "semsegmap/datasets/lidar_odometry_source.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/graph/trajectory.h"
@@ -136,6 +137,86 @@ TEST(Modes, AMapKeepsEarlierObservationsApartFromTheFinalOnes) {
   EXPECT_EQ(run.earlier_observations, earlier);
   EXPECT_EQ(run.duplicates_removed, 0u);
   EXPECT_GE(apart, earlier * 8 / 10) << "of " << earlier << " earlier observations";
+}
+
+// A descriptor of what one observation saw: its point count and extent. A segment seen by more
+// scans is described otherwise, so only the same cut of the same scan matches exactly.
+class ObservationDescriber : public Describer {
+ public:
+  DescriptorKind kind() const override { return DescriptorKind::kEigen; }
+  int dimension() const override { return 4; }
+  std::string fingerprint() const override { return "observation"; }
+  Eigen::MatrixXf describe(const std::vector<DescriptorInput>& batch) override {
+    Eigen::MatrixXf out(static_cast<Eigen::Index>(batch.size()), 4);
+    for (size_t i = 0; i < batch.size(); ++i) {
+      Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e9f), hi = -lo;
+      for (const EnrichedPoint& p : *batch[i].points) {
+        lo = lo.cwiseMin(Eigen::Vector3f(p.x, p.y, p.z));
+        hi = hi.cwiseMax(Eigen::Vector3f(p.x, p.y, p.z));
+      }
+      const auto row = static_cast<Eigen::Index>(i);
+      out(row, 0) = static_cast<float>(batch[i].points->size()) / 100.0f;
+      out.block<1, 3>(row, 1) = (hi - lo).transpose();
+    }
+    return out;
+  }
+};
+
+// localization.latest_scan_fallback_m: scans far apart leave the local map holding the place as
+// several scans saw it; the map here holds it as one scan did. Frame 40 after frame 20 (about
+// 20 m): the local map's segments are not the map's, the latest scan's own are.
+TEST(Modes, ScansFarApartLocalizeFromTheLatestScanWhenTheLocalMapDoesNot) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  PipelineConfig config = semsegmapConfig();
+  const auto describer = std::make_shared<ObservationDescriber>();
+  auto run = openDataset("sim:world=1,run=S2,preset=tiny,frames=60");
+  FrameSubset one_scan(*run, {40});
+  const auto map = std::make_shared<const TargetMap>(
+      runMapping(one_scan, config, PoseSource::kGroundTruth, describer).map);
+  ASSERT_GT(map->size(), 10u);
+  FrameSubset query(*run, {20, 40});
+  const double moved =
+      (query.frame(1).T_odom_base.translation() - query.frame(0).T_odom_base.translation()).norm();
+  ASSERT_GT(moved, 10.0);
+
+  const LocalizationRun without = runLocalization(query, config, map, describer);
+  for (const LocalizationRecord& r : without.localizations)
+    EXPECT_NE(r.frame_index, 1u) << "the local map of both scans localized";
+  config.localization.latest_scan_fallback_m = moved + 1.0;  // farther than the scans lie apart
+  EXPECT_TRUE(runLocalization(query, config, map, describer).localizations.empty());
+
+  config.localization.latest_scan_fallback_m = 5.0;
+  const LocalizationRun with = runLocalization(query, config, map, describer);
+  ASSERT_EQ(with.localizations.size(), 1u);
+  const LocalizationRecord& r = with.localizations[0];
+  EXPECT_EQ(r.frame_index, 1u);
+  EXPECT_TRUE(r.latest_scan);
+  EXPECT_LT(r.translation_error_m, 0.05);
+  EXPECT_LT(r.rotation_error_deg, 0.1);
+}
+
+// Segments leave the local map finished (their views go into the map), absorbed (their views go
+// to the survivor) or dropped as too large and then gone: the session holds views only of
+// segments still in the local map, so a long run's memory stays that of its local map.
+TEST(Modes, EarlierObservationsAreHeldOnlyForSegmentsStillInTheLocalMap) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  PipelineConfig config = semsegmapConfig();
+  config.target_map.earlier_observations_apart_m = 1.0;
+  config.segmentation.max_segment_points = 1500;  // some are dropped as too large, then leave
+  auto source = openDataset("sim:world=1,run=S2,preset=tiny,frames=60");
+  MappingSession session(config, source->info(), PoseSource::kGroundTruth,
+                         std::make_shared<OracleDescriber>());
+  size_t held = 0, gone = 0;
+  for (size_t i = 0; i < source->size(); ++i) {
+    session.process(source->frame(i));
+    for (SegmentId id : session.segmentsWithEarlierObservations()) {
+      ++held;
+      gone += session.pipeline().segmenter().segment(id) == nullptr;
+    }
+  }
+  EXPECT_GT(held, 100u);
+  EXPECT_EQ(gone, 0u) << "views held for segments that left the local map";
+  EXPECT_GT(session.finish().earlier_observations, 0u);
 }
 
 // A run that localized nothing has no mean error: null, never a 0 that reads as perfect.

@@ -94,6 +94,8 @@ Scene streetCorner(const Pose& T_map_local, uint64_t seed) {
     MapSegment s;
     s.points = shapes[i].whole;
     s.n_points = static_cast<uint32_t>(s.points.size());
+    s.centroid = Eigen::Vector3f::Zero();
+    for (const Eigen::Vector3f& p : s.points) s.centroid += p / static_cast<float>(s.n_points);
     scene.map.segments.push_back(s);
     Points local;
     for (const Eigen::Vector3f& p : shapes[i].part) {
@@ -145,6 +147,27 @@ TEST(PoseRefinement, RecoversAKnownOffsetOfTheCentroidPose) {
   EXPECT_LT(rotationErrorDeg(r.T_map_local, T), 0.2);
   EXPECT_GT(r.correction_m, 0.2);
   EXPECT_GE(r.correspondences, 1000u);
+}
+
+// One matched facade lets the registration slide along it and turn about its normal; the place's
+// unmatched segments near map segments under the match's pose (refinement.neighbours_m) pin both.
+TEST(PoseRefinement, UnmatchedNeighboursPinWhatOneMatchedSegmentLeavesLoose) {
+  const Pose T = truth();
+  Scene scene = streetCorner(T, 7);
+  scene.match.matches = {{0, 0}};
+  scene.match.T_map_local = centroidPose(T);
+  const auto placeError = [&](const Refinement& r) {
+    return (r.T_map_local * (T.inverse() * kPlace) - kPlace).norm();
+  };
+  const Refinement alone = refinePose(scene.match, scene.local, scene.map, enabled());
+  RefinementConfig config = enabled();
+  config.neighbours_m = 3.0;
+  const Refinement pinned = refinePose(scene.match, scene.local, scene.map, config);
+  ASSERT_TRUE(pinned.applied) << pinned.reason;
+  EXPECT_LT(placeError(pinned), 0.03);
+  EXPECT_LT(rotationErrorDeg(pinned.T_map_local, T), 0.2);
+  EXPECT_GT(placeError(alone), 0.2) << "one facade alone should leave the slide along it";
+  EXPECT_GT(pinned.correspondences, alone.correspondences);
 }
 
 TEST(PoseRefinement, KeepsTheMatchWhenThePointsDisagreeWithIt) {

@@ -244,6 +244,9 @@ TEST(PipelineConfig, UnknownKeysAndBadValuesNameTheFile) {
   expectError("segmentation:\n  d_segment_m: fast\n", "segmentation.d_segment_m");
   expectError("segmentation:\n  d_segment_m: -1\n", "d_segment_m");
   expectError("local_map: [1, 2]\n", "local_map");
+  expectError("refinement:\n  neighbours_m: -3\n", "refinement.neighbours_m");
+  expectError("localization:\n  latest_scan_fallback_m: -5\n",
+              "localization.latest_scan_fallback_m");
   std::filesystem::remove(path);
   EXPECT_THROW(loadPipelineConfig("/nonexistent/config.yaml"), std::runtime_error);
 }

@@ -221,12 +221,14 @@ class RefinementConfig:
     kernel_scale_m: float
     max_correction_m: float
     min_correspondences: int
+    neighbours_m: float
     def __init__(self, **fields: object) -> None: ...
 
 class LocalizationConfig:
     _fields: tuple[str, ...]
     localizer: LocalizerConfig
     every_n_frames: int
+    latest_scan_fallback_m: float
     refinement: RefinementConfig
     def __init__(self, **fields: object) -> None: ...
 
@@ -521,6 +523,8 @@ class LocalizationRecord:
     def refined(self) -> bool: ...
     @property
     def refinement_correction_m(self) -> float: ...
+    @property
+    def latest_scan(self) -> bool: ...
 
 class LocalizationSummary:
     @property

@@ -78,10 +78,12 @@ void bindLocalizationConfigs(py::module_& m) {
       .field("fine_distance_m", &RefinementConfig::fine_distance_m)
       .field("kernel_scale_m", &RefinementConfig::kernel_scale_m)
       .field("max_correction_m", &RefinementConfig::max_correction_m)
-      .field("min_correspondences", &RefinementConfig::min_correspondences);
+      .field("min_correspondences", &RefinementConfig::min_correspondences)
+      .field("neighbours_m", &RefinementConfig::neighbours_m);
   StructBinding<LocalizationConfig>(m, "LocalizationConfig", "pipeline/pipeline_config.h")
       .field("localizer", &LocalizationConfig::localizer)
       .field("every_n_frames", &LocalizationConfig::every_n_frames)
+      .field("latest_scan_fallback_m", &LocalizationConfig::latest_scan_fallback_m)
       .field("refinement", &LocalizationConfig::refinement);
   using TMB = TargetMapBuilderConfig;
   StructBinding<TMB>(m, "TargetMapBuilderConfig", "localize/target_map.h")

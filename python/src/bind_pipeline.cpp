@@ -291,7 +291,9 @@ void bindLocalizationResults(py::module_& m) {
           },
           "(K, 2, 3) float32: the local centroid carried into the map, the target's")
       .def_readonly("refined", &LocalizationRecord::refined)
-      .def_readonly("refinement_correction_m", &LocalizationRecord::refinement_correction_m);
+      .def_readonly("refinement_correction_m", &LocalizationRecord::refinement_correction_m)
+      .def_readonly("latest_scan", &LocalizationRecord::latest_scan,
+                    "localized by the latest scan's own segments (latest_scan_fallback_m)");
   py::class_<LocalizationSummary>(m, "LocalizationSummary")
       .def_readonly("localizations", &LocalizationSummary::localizations)
       .def_readonly("below_1m", &LocalizationSummary::below_1m)

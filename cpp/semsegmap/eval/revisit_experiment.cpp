@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/frame_subset.h"
 #include "semsegmap/eval/ground_truth_check.h"
 #include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/localization_metrics.h"
@@ -19,27 +20,6 @@
 namespace semsegmap {
 
 namespace {
-
-// Some frames of a dataset, numbered from 0 in the order given, as the sessions and
-// forEachFrame expect; `datasetFrame` maps a number back.
-class FrameSubset : public FrameSource {
- public:
-  FrameSubset(FrameSource& source, std::vector<size_t> frames)
-      : source_(source), frames_(std::move(frames)) {}
-  const DatasetInfo& info() const override { return source_.info(); }
-  size_t size() const override { return frames_.size(); }
-  Frame frame(size_t index) override {
-    Frame f = source_.frame(frames_.at(index));
-    f.index = index;
-    return f;
-  }
-  double frameTime(size_t index) override { return source_.frameTime(frames_.at(index)); }
-  size_t datasetFrame(size_t index) const { return frames_.at(index); }
-
- private:
-  FrameSource& source_;
-  std::vector<size_t> frames_;
-};
 
 std::vector<size_t> framesOf(const std::vector<FrameRange>& ranges) {
   std::vector<size_t> frames;

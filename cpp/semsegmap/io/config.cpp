@@ -193,6 +193,9 @@ void checkPipelineConfig(const std::filesystem::path& path, const PipelineConfig
         "refinement: need 0 < fine_distance_m <= coarse_distance_m");
   check(rf.kernel_scale_m > 0, "refinement.kernel_scale_m: must be positive");
   check(rf.max_correction_m > 0, "refinement.max_correction_m: must be positive");
+  check(rf.neighbours_m >= 0, "refinement.neighbours_m: must not be negative");
+  check(loc.latest_scan_fallback_m >= 0,
+        "localization.latest_scan_fallback_m: must not be negative");
   check(lc.exclude_recent_m >= 0, "loop_closure.exclude_recent_m: must not be negative");
 }
 
@@ -361,7 +364,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"resolution_m", set(loc.localizer.verification.resolution_m)},
                {"min_inliers", count(loc.localizer.verification.min_inliers, 3, 10000)},
                {"min_local_segments", count(loc.localizer.min_local_segments, 0, 1000000)},
-               {"every_n_frames", count(loc.every_n_frames, 1, 1000000)}});
+               {"every_n_frames", count(loc.every_n_frames, 1, 1000000)},
+               {"latest_scan_fallback_m", set(loc.latest_scan_fallback_m)}});
   auto& rf = loc.refinement;
   readSection(path, root, "refinement",
               {{"enabled", set(rf.enabled)},
@@ -370,7 +374,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"fine_distance_m", set(rf.fine_distance_m)},
                {"kernel_scale_m", set(rf.kernel_scale_m)},
                {"max_correction_m", set(rf.max_correction_m)},
-               {"min_correspondences", count(rf.min_correspondences, 0, kMaxPoints)}});
+               {"min_correspondences", count(rf.min_correspondences, 0, kMaxPoints)},
+               {"neighbours_m", set(rf.neighbours_m)}});
   readSection(path, root, "target_map",
               {{"duplicate_distance_m", set(c.target_map.duplicate_distance_m)},
                // The map file stores a segment's point count in 16 bits (io/map_file.cpp).

@@ -16,8 +16,9 @@ namespace semsegmap {
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
     // refinement_m: how far pose refinement moved the pose; empty where it was not applied.
+    // latest_scan: 1 where the latest scan's own segments localized (latest_scan_fallback).
     out << "frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,rotation_error_deg,"
-           "refinement_m\n";
+           "refinement_m,latest_scan\n";
     char line[512];
     for (const LocalizationRecord& r : run.localizations) {
       const auto v = toXyzQuat(r.T_map_base);
@@ -38,7 +39,7 @@ void writeLocalizationsCsv(const std::filesystem::path& path, const Localization
       } else {
         out << ',';
       }
-      out << '\n';
+      out << ',' << (r.latest_scan ? 1 : 0) << '\n';
     }
   });
 }

@@ -17,25 +17,46 @@ struct MatchedPoints {
   std::vector<Eigen::Vector3d> local, target;
 };
 
+void addPoints(const std::vector<Eigen::Vector3f>& points, std::vector<Eigen::Vector3d>& out) {
+  for (const Eigen::Vector3f& p : points) out.push_back(p.cast<double>());
+}
+
+Eigen::Vector3d meanOf(const std::vector<Eigen::Vector3f>& points) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& p : points) c += p.cast<double>();
+  return c / static_cast<double>(points.size());
+}
+
+// Unpaired segments near each other under the match's pose join the registration.
+void markNeighbours(const Localization& match,
+                    const std::vector<std::vector<Eigen::Vector3f>>& local_points,
+                    const TargetMap& map, double distance_m, std::vector<bool>& local_used,
+                    std::vector<bool>& target_used) {
+  for (size_t i = 0; i < local_points.size(); ++i) {
+    if (local_points[i].empty()) continue;
+    const Eigen::Vector3f c = (match.T_map_local * meanOf(local_points[i])).cast<float>();
+    for (size_t j = 0; j < map.size(); ++j)
+      if ((map.segments[j].centroid - c).norm() < distance_m) local_used[i] = target_used[j] = true;
+  }
+}
+
 MatchedPoints gather(const Localization& match,
                      const std::vector<std::vector<Eigen::Vector3f>>& local_points,
-                     const TargetMap& map, size_t max_points) {
-  MatchedPoints out;
+                     const TargetMap& map, const RefinementConfig& config) {
   std::vector<bool> local_used(local_points.size()), target_used(map.size());
   for (const auto& [query, target] : match.matches) {
     if (query >= local_points.size() || target >= map.size())
       throw std::out_of_range("refinePose: a match names a segment that is not there");
-    if (!local_used[query]) {
-      local_used[query] = true;
-      for (const Eigen::Vector3f& p : subsamplePoints(local_points[query], max_points))
-        out.local.push_back(p.cast<double>());
-    }
-    if (!target_used[target]) {
-      target_used[target] = true;
-      for (const Eigen::Vector3f& p : map.segments[target].points)
-        out.target.push_back(p.cast<double>());
-    }
+    local_used[query] = target_used[target] = true;
   }
+  if (config.neighbours_m > 0)
+    markNeighbours(match, local_points, map, config.neighbours_m, local_used, target_used);
+  MatchedPoints out;
+  for (size_t i = 0; i < local_points.size(); ++i)
+    if (local_used[i])
+      addPoints(subsamplePoints(local_points[i], config.max_points_per_segment), out.local);
+  for (size_t j = 0; j < map.size(); ++j)
+    if (target_used[j]) addPoints(map.segments[j].points, out.target);
   return out;
 }
 
@@ -67,7 +88,7 @@ bool hasSegmentPoints(const TargetMap& map) {
 Refinement refinePose(const Localization& match,
                       const std::vector<std::vector<Eigen::Vector3f>>& local_points,
                       const TargetMap& map, const RefinementConfig& config) {
-  const MatchedPoints m = gather(match, local_points, map, config.max_points_per_segment);
+  const MatchedPoints m = gather(match, local_points, map, config);
   if (m.local.size() < config.min_correspondences || m.target.size() < config.min_correspondences)
     return notApplied(match, "too few segment points");
   // ICP linearises rotations about the source frame's origin; the local map's origin (where the

@@ -31,6 +31,11 @@ struct RefinementConfig {
   // centroid pose: the points then disagree with the verified match more than its error allows.
   double max_correction_m = 1.5;
   size_t min_correspondences = 50;
+  // Also register the segments the match did not pair: every local segment whose centroid, under
+  // the match's pose, lies within this distance of a target segment's centroid, with those target
+  // segments. A few matched segments constrain the rotation poorly (seven poles and trunks in a
+  // row leave a roll about their line); the place's other segments pin it. 0: matched only.
+  double neighbours_m = 0.0;
 };
 
 struct Refinement {
@@ -42,7 +47,8 @@ struct Refinement {
 };
 
 // Refines `match.T_map_local`. `local_points[i]` are the points of query segment i (local map
-// frame), as indexed by match.matches; target points come from map.segments[j].points.
+// frame), as indexed by match.matches (with neighbours_m, of every query segment; an empty one is
+// left out); target points come from map.segments[j].points.
 Refinement refinePose(const Localization& match,
                       const std::vector<std::vector<Eigen::Vector3f>>& local_points,
                       const TargetMap& map, const RefinementConfig& config);

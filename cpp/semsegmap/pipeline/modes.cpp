@@ -90,8 +90,10 @@ void MappingSession::keepEarlierObservations(const FrameResult& r) {
     const auto it = described.find(id);
     if (it == described.end()) continue;  // finished this frame: its final observation goes in
     const DescribedSegment& e = it->second;
-    const bool first = earlier_.count(id) == 0;
     SegmentViews& views = earlier_[id];
+    // Its first observation: a segment that absorbed others before it was first observed holds
+    // their views, but none of its own yet.
+    const bool first = views.latest.descriptor.size() == 0;
     KeptObservation k;
     k.segment.centroid = e.centroid;
     k.segment.n_points = e.n_points;
@@ -109,11 +111,27 @@ void MappingSession::keepEarlierObservations(const FrameResult& r) {
   }
 }
 
+// A segment can also leave the local map unfinished: one dropped as too large (its observations
+// cleared) is never handed out when its voxels leave. Its views go with it, as its final
+// observation does, instead of being held until the run ends.
+void MappingSession::forgetVanishedSegments() {
+  const IncrementalSegmenter& segmenter = pipeline_.segmenter();
+  for (auto it = earlier_.begin(); it != earlier_.end();)
+    it = segmenter.segment(it->first) ? std::next(it) : earlier_.erase(it);
+}
+
+std::vector<SegmentId> MappingSession::segmentsWithEarlierObservations() const {
+  std::vector<SegmentId> out;
+  for (const auto& [id, views] : earlier_) out.push_back(id);
+  return out;
+}
+
 void MappingSession::process(const Frame& frame) {
   const FrameResult r = pipeline_.process(frame);
   run_.trajectory.push_back(r.T_local_base);
   keepEarlierObservations(r);
   add(r.segmentation.finished, r.finished_descriptors);
+  forgetVanishedSegments();
   run_.stats.total += r.times;
   ++run_.stats.frames;
 }
@@ -157,65 +175,96 @@ LocalizationSession::LocalizationSession(const PipelineConfig& config, const Dat
                                          std::shared_ptr<Describer> describer,
                                          MapSettingsCheck settings)
     : config_(config),
+      info_(info),
+      describer_(describer),
       localizer_(checkedMap(std::move(map), *describer, config, settings),
                  config.localization.localizer),
-      pipeline_(config, info, PoseSource::kOdometry, std::move(describer)) {}
+      pipeline_(config, info, PoseSource::kOdometry, describer) {}
 
 void LocalizationSession::process(const Frame& frame) {
   FrameResult r = pipeline_.process(frame);
-  if (!run_.trajectory_odom.empty())
-    run_.distance_m +=
-        (r.T_local_base.translation() - run_.trajectory_odom.back().translation()).norm();
+  const double moved =
+      run_.trajectory_odom.empty()
+          ? 0.0
+          : (r.T_local_base.translation() - run_.trajectory_odom.back().translation()).norm();
+  run_.distance_m += moved;
   run_.trajectory_odom.push_back(r.T_local_base);
   if (frame.T_world_base) run_.trajectory_gt.push_back(*frame.T_world_base);
   const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
   if (frames_++ % every == 0) {
     const auto t0 = std::chrono::steady_clock::now();
-    const LocalSegmentQuery q = pipeline_.localSegmentQuery();
-    auto found = localizer_.localize(q.centroids, q.descriptors);
-    std::optional<Refinement> refined;
-    if (found && config_.localization.refinement.enabled) {
-      refined = refine(*found, q);
-      found->T_map_local = refined->T_map_local;
-    }
+    Attempt a = attempt(pipeline_);
+    Pose T_map_base = Pose::Identity();
+    const double fallback_m = config_.localization.latest_scan_fallback_m;
+    const bool latest_scan = !a.found && fallback_m > 0 && moved >= fallback_m;
+    if (a.found)
+      T_map_base = a.found->T_map_local * r.T_local_base;
+    else if (latest_scan)
+      a = attemptLatestScan(frame, T_map_base);
     r.times.localize_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (found) record(frame, r, *found, q, refined ? &*refined : nullptr);
+    if (a.found) record(frame, T_map_base, a, latest_scan);
   }
   run_.stats.total += r.times;
   ++run_.stats.frames;
 }
 
-Refinement LocalizationSession::refine(const Localization& l, const LocalSegmentQuery& q) const {
-  // Only the matched segments' points, and only once a match is found: copying every local
-  // segment's points on every frame would be most of the work for nothing.
+LocalizationSession::Attempt LocalizationSession::attempt(const Pipeline& pipeline) const {
+  Attempt a;
+  a.query = pipeline.localSegmentQuery();
+  a.found = localizer_.localize(a.query.centroids, a.query.descriptors);
+  if (a.found && config_.localization.refinement.enabled) {
+    a.refined = refine(pipeline, *a.found, a.query);
+    a.found->T_map_local = a.refined->T_map_local;
+  }
+  return a;
+}
+
+LocalizationSession::Attempt LocalizationSession::attemptLatestScan(const Frame& frame,
+                                                                    Pose& T_map_base) const {
+  Pipeline scan(config_, info_, PoseSource::kOdometry, describer_);
+  const FrameResult r = scan.process(frame);
+  Attempt a = attempt(scan);
+  if (a.found) T_map_base = a.found->T_map_local * r.T_local_base;
+  return a;
+}
+
+Refinement LocalizationSession::refine(const Pipeline& pipeline, const Localization& l,
+                                       const LocalSegmentQuery& q) const {
+  // Only the matched segments' points (with refinement.neighbours_m, every local segment's), and
+  // only once a match is found: copying every local segment's points on every frame would be
+  // most of the work for nothing.
   std::vector<std::vector<Eigen::Vector3f>> local_points(q.ids.size());
+  if (config_.localization.refinement.neighbours_m > 0)
+    for (size_t i = 0; i < q.ids.size(); ++i) local_points[i] = pipeline.observedPoints(q.ids[i]);
   for (const auto& [query, target] : l.matches)
-    if (local_points.at(query).empty())
-      local_points[query] = pipeline_.observedPoints(q.ids[query]);
+    if (local_points.at(query).empty()) local_points[query] = pipeline.observedPoints(q.ids[query]);
   return refinePose(l, local_points, localizer_.map(), config_.localization.refinement);
 }
 
-void LocalizationSession::record(const Frame& frame, const FrameResult& r, const Localization& l,
-                                 const LocalSegmentQuery& q, const Refinement* refined) {
+void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, const Attempt& a,
+                                 bool latest_scan) {
+  const Localization& l = *a.found;
   LocalizationRecord rec;
   rec.frame_index = frame.index;
   rec.timestamp_s = frame.timestamp_s;
-  rec.T_map_base = l.T_map_local * r.T_local_base;
+  rec.T_map_base = T_map_base;
   rec.inliers = l.inliers;
   rec.candidates = l.candidates;
+  rec.latest_scan = latest_scan;
   if (frame.T_world_base) {
     rec.T_world_base = *frame.T_world_base;
     rec.translation_error_m = translationError(rec.T_map_base, *frame.T_world_base);
     rec.rotation_error_deg = rotationErrorDeg(rec.T_map_base, *frame.T_world_base);
   }
-  if (refined) {
-    rec.refined = refined->applied;
-    rec.refinement_correction_m = refined->correction_m;
+  if (a.refined) {
+    rec.refined = a.refined->applied;
+    rec.refinement_correction_m = a.refined->correction_m;
   }
   for (const auto& [query, target] : l.matches)
-    rec.matches.emplace_back((l.T_map_local * q.centroids.at(query).cast<double>()).cast<float>(),
-                             localizer_.map().segments.at(target).centroid);
+    rec.matches.emplace_back(
+        (l.T_map_local * a.query.centroids.at(query).cast<double>()).cast<float>(),
+        localizer_.map().segments.at(target).centroid);
   run_.localizations.push_back(std::move(rec));
 }
 

@@ -46,10 +46,15 @@ class MappingSession {
                  std::shared_ptr<Describer> describer);
   void process(const Frame& frame);
   MappingRun finish();  // once, after the last frame
+  // The segments whose earlier observations the session holds until they finish
+  // (target_map.earlier_observations_apart_m): each is still in the local map.
+  std::vector<SegmentId> segmentsWithEarlierObservations() const;
+  const Pipeline& pipeline() const { return pipeline_; }
 
  private:
   void add(const std::vector<Segment>& segments, const std::vector<Eigen::VectorXf>& d);
   void keepEarlierObservations(const FrameResult& r);
+  void forgetVanishedSegments();
   struct KeptObservation {
     MapSegment segment;
     Eigen::VectorXf descriptor;
@@ -87,6 +92,8 @@ struct LocalizationRecord {
   // Pose refinement (localization.refinement): whether it moved T_map_base, and by how much.
   bool refined = false;
   double refinement_correction_m = 0.0;
+  // Localized by the latest scan's own segments (localization.latest_scan_fallback).
+  bool latest_scan = false;
 };
 
 struct LocalizationRun {
@@ -111,11 +118,22 @@ class LocalizationSession {
   LocalizationRun take() { return std::move(run_); }
 
  private:
-  Refinement refine(const Localization& l, const LocalSegmentQuery& q) const;
-  // `refined`: the refinement of `l`, when it was refined.
-  void record(const Frame& frame, const FrameResult& r, const Localization& l,
-              const LocalSegmentQuery& q, const Refinement* refined);
+  // One localization attempt on a pipeline's local segments.
+  struct Attempt {
+    std::optional<Localization> found;
+    std::optional<Refinement> refined;
+    LocalSegmentQuery query;
+  };
+  Attempt attempt(const Pipeline& pipeline) const;
+  // The latest scan's own segments (localization.latest_scan_fallback); `T_map_base` is set
+  // when they localize.
+  Attempt attemptLatestScan(const Frame& frame, Pose& T_map_base) const;
+  Refinement refine(const Pipeline& pipeline, const Localization& l,
+                    const LocalSegmentQuery& q) const;
+  void record(const Frame& frame, const Pose& T_map_base, const Attempt& a, bool latest_scan);
   PipelineConfig config_;
+  DatasetInfo info_;
+  std::shared_ptr<Describer> describer_;
   Localizer localizer_;
   Pipeline pipeline_;
   LocalizationRun run_;
