@@ -251,9 +251,11 @@ TEST(RevisitExperiment, RealKittiRevisitsAreFoundAndNoneIsFarOff) {
     }
   }
   EXPECT_EQ(r.registered_below_0_3m, r.registered_compared) << "within 0.3 m and 1 degree";
-  // The shipped configuration names no LiDAR-only model: the colour model sees geometry alone,
-  // and the run says so.
+  // The input has neither colour nor classes: the run takes the configuration's LiDAR-only
+  // model (the S1 model, which sees grey points best) and says so.
   EXPECT_NE(r.model_note.find("no colour and no classes"), std::string::npos) << r.model_note;
+  EXPECT_NE(r.model_note.find("model_lidar_only"), std::string::npos) << r.model_note;
+  EXPECT_EQ(std::filesystem::path(r.model).filename(), "semsegmap-net.model") << r.model;
 }
 
 // Woken up with an empty local map at each revisit, from the sparse scans 10-20 m apart. The map
