@@ -12,7 +12,8 @@ namespace semsegmap {
 
 namespace {
 
-// The matched segments' points: local ones (subsampled, local frame) and target ones (map frame).
+// The registered segments' points: local ones (subsampled, local frame) and target ones (map
+// frame); the matched segments, and with neighbours_m their neighbours.
 struct MatchedPoints {
   std::vector<Eigen::Vector3d> local, target;
 };
@@ -27,7 +28,9 @@ Eigen::Vector3d meanOf(const std::vector<Eigen::Vector3f>& points) {
   return c / static_cast<double>(points.size());
 }
 
-// Unpaired segments near each other under the match's pose join the registration.
+// Unpaired segments near each other under the match's pose join the registration. A linear scan
+// of the map: it runs once a localization, and 100 local segments against a map of 10^4 are 10^6
+// distance checks, a few milliseconds.
 void markNeighbours(const Localization& match,
                     const std::vector<std::vector<Eigen::Vector3f>>& local_points,
                     const TargetMap& map, double distance_m, std::vector<bool>& local_used,
