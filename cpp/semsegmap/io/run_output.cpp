@@ -16,7 +16,7 @@ namespace semsegmap {
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
     // refinement_m: how far pose refinement moved the pose; empty where it was not applied.
-    // latest_scan: 1 where the latest scan's own segments localized (latest_scan_fallback).
+    // latest_scan: 1 where the latest scan's own segments localized (latest_scan_fallback_m).
     out << "frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,rotation_error_deg,"
            "refinement_m,latest_scan\n";
     char line[512];

@@ -33,11 +33,11 @@ void checkConfig(const TrainConfig& c) {
     fail("distillation weight must be finite and not negative");
 }
 
+}  // namespace
+
 // A teacher must describe in the student's space: the same kind of network and descriptor size.
 // With start_from_teacher the student takes its weights, so they must match by name and shape
 // (the modalities a network sees change its input, not its weights).
-}  // namespace
-
 void checkTeacher(const TrainConfig& c, DescriptorNetImpl& teacher) {
   const NetConfig& t = teacher.config();
   auto fail = [](const std::string& what) { throw std::invalid_argument("teacher: " + what); };

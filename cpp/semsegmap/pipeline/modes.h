@@ -92,7 +92,7 @@ struct LocalizationRecord {
   // Pose refinement (localization.refinement): whether it moved T_map_base, and by how much.
   bool refined = false;
   double refinement_correction_m = 0.0;
-  // Localized by the latest scan's own segments (localization.latest_scan_fallback).
+  // Localized by the latest scan's own segments (localization.latest_scan_fallback_m).
   bool latest_scan = false;
 };
 
@@ -125,7 +125,7 @@ class LocalizationSession {
     LocalSegmentQuery query;
   };
   Attempt attempt(const Pipeline& pipeline) const;
-  // The latest scan's own segments (localization.latest_scan_fallback); `T_map_base` is set
+  // The latest scan's own segments (localization.latest_scan_fallback_m); `T_map_base` is set
   // when they localize.
   Attempt attemptLatestScan(const Frame& frame, Pose& T_map_base) const;
   Refinement refine(const Pipeline& pipeline, const Localization& l,
