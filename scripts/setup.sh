@@ -5,6 +5,8 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config clang-format
+  # keeps compiler output between the builds of one machine (CMakeLists.txt); never required
+  ccache
   libeigen3-dev libembree-dev libtbb-dev libyaml-cpp-dev libopencv-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtorch-dev libpcl-dev libqhull-dev libfaiss-dev libceres-dev
