@@ -767,7 +767,7 @@ class CliMaps : public ::testing::Test {
 };
 
 // `map` without --points keeps the points its configuration asks for, so that a configuration
-// that refines poses (config/semsegmap-kitti.yaml) builds maps its own localization accepts.
+// that refines poses (config/lidar-camera.yaml) builds maps its own localization accepts.
 TEST_F(CliMaps, MapKeepsTheConfiguredSegmentPointsUnlessPointsIsGiven) {
   const std::string refine =
       eigenConfig(tmp_.path(), "refine.yaml",
@@ -909,7 +909,7 @@ TEST(CliEvalRevisits, RunsOnTheRealKittiScansInEveryBuild) {
   if (!std::filesystem::exists(kitti / "poses.txt"))
     GTEST_SKIP() << "no real KITTI sample (" << kitti.string() << ")";
   TempDir tmp;
-  std::string settings = readFile("config/semsegmap-kitti.yaml");  // ctest runs in the source tree
+  std::string settings = readFile("config/lidar-camera.yaml");  // ctest runs in the source tree
   settings = settings.substr(0, settings.find("descriptor:")) + "descriptor:\n  kind: eigen\n" +
              settings.substr(settings.find("localization:"));
   const std::filesystem::path config = tmp.path() / "eigen-kitti.yaml", out = tmp.path() / "rev";

@@ -384,5 +384,28 @@ TEST(SemanticsConfig, ReadFromTheConfigRelativeToIt) {
   EXPECT_TRUE(throwsWith([&] { loadPipelineConfig(file); }, {"input_width, input_height"}));
 }
 
+// A shipped config copied elsewhere (as a user starts their own) loses its ../models/: its
+// models are then found by name among the shipped ones, and a model of the user's own that is
+// missing keeps its path beside the config, for the model's loader to refuse by that name.
+TEST(PipelineConfigFile, ACopiedConfigStillFindsItsShippedModels) {
+  TempDir tmp;
+  const fs::path source = fs::path(SEMSEGMAP_SOURCE_DIR);
+  const fs::path copy = tmp.path() / "my-rig.yaml";
+  fs::copy_file(source / "config" / "lidar-camera.yaml", copy);
+  const PipelineConfig c = loadPipelineConfig(copy);
+  ASSERT_TRUE(fs::exists(c.descriptor.model)) << c.descriptor.model;
+  EXPECT_TRUE(
+      fs::equivalent(c.descriptor.model, source / "models" / "semsegmap-net-3worlds.model"));
+  EXPECT_TRUE(
+      fs::equivalent(c.descriptor.model_lidar_only, source / "models" / "semsegmap-net.model"));
+  // In place, the path beside the config is the one used.
+  const PipelineConfig shipped = loadPipelineConfig(source / "config" / "lidar-camera.yaml");
+  EXPECT_EQ(
+      shipped.descriptor.model,
+      (source / "config" / "../models/semsegmap-net-3worlds.model").lexically_normal().string());
+  std::ofstream(copy) << "descriptor:\n  kind: semsegmap-net\n  model: mine/net.model\n";
+  EXPECT_EQ(loadPipelineConfig(copy).descriptor.model, (tmp.path() / "mine/net.model").string());
+}
+
 }  // namespace
 }  // namespace semsegmap

@@ -149,9 +149,9 @@ const char* const kDatasetNotes =
     "    [,base_frame=F][,odom_frame=F][,tolerance=S] (ROS 1 and ROS 2 bags),\n"
     "  "
     "sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small][,sweep=1]\n"
-    "    [,label_noise=0..3][,lidar=paper|hdl64|vlp32|os128|solid][,cameras=0][,classes=0]\n"
-    "    [,laps=N] (the built-in simulator; cameras=0,classes=0: a LiDAR without a camera;\n"
-    "    laps: S2 or S3 driven N times without stopping)\n";
+    "    [,label_noise=0..3][,lidar=paper|hdl64|vlp32|os128|solid][,cameras=0|front[+left...]]\n"
+    "    [,classes=0][,laps=N] (the built-in simulator; cameras=0,classes=0: a LiDAR without a\n"
+    "    camera; cameras=front: its front camera alone; laps: S2 or S3 driven N times)\n";
 #else
     "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,\n"
     "  folder:DIR[,rig=FILE][,times=FILE][,tolerance=S] (scans and pictures, docs/rig-format.md),\n"

@@ -162,6 +162,7 @@ class LocalMapConfig:
     dynamic_vote_share: float
     remove_ground_classes: bool
     remove_unknown_class: bool
+    remove_unobserved: bool
     geometric_ground_removal: bool
     ground: GroundRemovalConfig
     def __init__(self, **fields: object) -> None: ...

@@ -271,7 +271,8 @@ void bindDatasetInfo(py::module_& m) {
 }  // namespace
 
 void bindCore(py::module_& m) {
-  PYBIND11_NUMPY_DTYPE(EnrichedPoint, x, y, z, h, s, v, class_id, has_color, instance_id);
+  PYBIND11_NUMPY_DTYPE(EnrichedPoint, x, y, z, h, s, v, class_id, has_color, has_class,
+                       instance_id);
   m.attr("ENRICHED_POINT_DTYPE") = py::dtype::of<EnrichedPoint>();
   bindFrame(m);
   bindRig(m);

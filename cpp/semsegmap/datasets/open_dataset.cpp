@@ -47,6 +47,21 @@ LidarModel lidarPresetOf(const std::string& spec, const std::string& name) {
   }
 }
 
+// cameras=0 or 1 (none or all), or the cameras to keep by name joined by '+': cameras=front.
+void parseSimCameras(const std::string& spec, const std::string& value, sim::SimConfig& config) {
+  if (value == "0" || value == "1") {
+    config.render_cameras = value == "1";
+    return;
+  }
+  std::stringstream names(value);
+  for (std::string name; std::getline(names, name, '+');) {
+    if (name.empty())
+      throw std::invalid_argument("dataset '" + spec + "': cameras=" + value +
+                                  ": expected 0, 1 or camera names joined by '+'");
+    config.camera_names.push_back(name);
+  }
+}
+
 std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::string& args) {
   std::string preset = "full";
   uint64_t world_seed = 1;
@@ -72,7 +87,7 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
     else if (key == "preset")
       preset = value;
     else if (key == "cameras")
-      config.render_cameras = parseUnsigned(spec, key, value) != 0;
+      parseSimCameras(spec, value, config);
     else if (key == "lidar")
       config.rig.lidar = lidarPresetOf(spec, value);
     else if (key == "classes")
