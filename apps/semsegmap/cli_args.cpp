@@ -30,16 +30,17 @@ bool parseNumber(const std::string& text, double* out) {
   return !text.empty() && used == text.size() && std::isfinite(*out);
 }
 
-// The literal words an option accepts ("point|voxel"), or none when any value goes: without a
-// '|', or when one of the items is itself a placeholder in capitals ("FILE|lidar": a file, or the
-// word lidar).
+// The literal words an option accepts ("point|voxel", "S0|S1"), or none when any value goes:
+// without a '|', or when one of the items is itself a placeholder, a word of capital letters
+// alone ("FILE|lidar": a file, or the word lidar).
 std::vector<std::string> choicesOf(const OptionSpec& option) {
   std::vector<std::string> out;
   if (option.placeholder.find('|') == std::string::npos) return out;
   std::stringstream s(option.placeholder);
   std::string item;
   while (std::getline(s, item, '|')) {
-    if (std::any_of(item.begin(), item.end(), [](char c) { return c >= 'A' && c <= 'Z'; }))
+    if (!item.empty() &&
+        std::all_of(item.begin(), item.end(), [](char c) { return c >= 'A' && c <= 'Z'; }))
       return {};
     out.push_back(item);
   }
