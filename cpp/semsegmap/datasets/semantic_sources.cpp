@@ -18,6 +18,7 @@ class RelabelledSource : public FrameSource {
   const DatasetInfo& info() const override { return source_->info(); }
   size_t size() const override { return source_->size(); }
   double frameTime(size_t index) override { return source_->frameTime(index); }
+  std::optional<size_t> frameNumber(size_t index) override { return source_->frameNumber(index); }
 
  protected:
   std::unique_ptr<FrameSource> source_;
