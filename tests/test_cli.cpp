@@ -727,6 +727,62 @@ TEST(CliPoseFiles, MapAndLocalizeWithOdometryFilesInKittiAndTumFormat) {
       << few.err;
 }
 
+// The segmentation network of the tests (tests' colour4.onnx) in a config, with its class map.
+std::string networkConfig(const std::filesystem::path& dir) {
+  std::ofstream(dir / "colour.yaml")
+      << "name: colour4\nclasses:\n  - {id: 0, name: red, class: building}\n"
+         "  - {id: 1, name: green, class: vegetation}\n  - {id: 2, name: blue, class: sky}\n"
+         "  - {id: 3, name: dark, class: road}\n";
+  std::ofstream(dir / "net.yaml") << "semantics:\n  model: " SEMSEGMAP_ONNX_DIR
+                                     "/colour4.onnx\n"
+                                     "  class_map: colour.yaml\n  mean: [0, 0, 0]\n"
+                                     "  std: [1, 1, 1]\n  replace_dataset_labels: true\n";
+  return (dir / "net.yaml").string();
+}
+
+// `label --max-frames 1` records the one frame it labelled, and `map --labels` refuses the set
+// unless it reads no more; a `label` stopped half way leaves no labels.yaml, even where an
+// earlier whole set was.
+TEST(CliLabelSets, ASetRecordsTheFramesItLabelledAndAStoppedRunLeavesNoneWhole) {
+  if (!built("simulate")) GTEST_SKIP() << "the pictures come from the simulator";
+  TempDir tmp;
+  const std::filesystem::path dir = tmp.path(), labels = dir / "labels";
+  const std::string net = networkConfig(dir);
+  const std::string data = " --dataset sim:preset=tiny,frames=2";
+  const Result r =
+      run("label" + data + " --config " + net + " --out " + labels.string() + " --max-frames 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string yaml = readFile(labels / "labels.yaml");
+  EXPECT_NE(yaml.find("frames: 1\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("dataset_frames: 2\n"), std::string::npos) << yaml;
+  const std::string map =
+      " --config " + eigenConfig(dir, "eigen.yaml") + " --labels " + labels.string() + " --out ";
+  const Result all = run("map" + data + map + (dir / "all.map").string());
+  EXPECT_EQ(all.code, 1);
+  EXPECT_EQ(lines(all.err), 1u) << all.err;
+  EXPECT_NE(all.err.find(labels.string() + ": the label set labels frames 0 to 0 only"),
+            std::string::npos)
+      << all.err;
+  const Result one = run("map" + data + map + (dir / "one.map").string() + " --max-frames 1");
+  EXPECT_EQ(one.code, 0) << one.err;
+
+  // A whole set, then a run over it that fails at its last frame's picture.
+  const std::filesystem::path copy = copyOfDataset(dir / "data");
+  const std::string label =
+      "label --dataset " + copy.string() + " --config " + net + " --out " + labels.string();
+  ASSERT_EQ(run(label).code, 0);
+  ASSERT_TRUE(std::filesystem::exists(labels / "labels.yaml"));
+  // Its header stays (the up-front check reads the size), its pixels are cut off.
+  const std::filesystem::path picture = copy / "cam0" / "000002.png";
+  std::filesystem::resize_file(picture, std::filesystem::file_size(picture) / 2);
+  const Result stopped = run(label);
+  EXPECT_EQ(stopped.code, 1) << stopped.err;
+  EXPECT_FALSE(std::filesystem::exists(labels / "labels.yaml"));
+  const Result refused = run("map --dataset " + copy.string() + map + (dir / "x.map").string());
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_NE(refused.err.find("labels.yaml: missing"), std::string::npos) << refused.err;
+}
+
 // One file as odometry and ground truth: the run says so, and its errors are marked.
 TEST(CliPoseFiles, GroundTruthAsOdometryIsSaidAndMarked) {
   if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";

@@ -182,7 +182,8 @@ std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetO
          ": its ground-truth poses serve as its odometry too (--odometry FILE or --odometry "
          "lidar for odometry of its own): errors measured against them are marked so");
   if (!options.labels.empty())
-    source = withLabelSet(std::move(source), options.labels, options.class_maps_dir);
+    source = withLabelSet(std::move(source), options.labels, options.class_maps_dir,
+                          options.frames_to_check);
   if (options.semantics.model.empty()) return source;
   auto network = loadSegmentationNetwork(options.semantics, source->info(), options.class_maps_dir);
   return withSegmentationNetwork(std::move(source), std::move(network));
