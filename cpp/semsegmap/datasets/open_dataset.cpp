@@ -192,8 +192,13 @@ std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetO
   poses.kitti_calib = options.kitti_calib;
   source = withPoseFiles(std::move(source), poses);
   if (lidar_odometry) source = withLidarOdometry(std::move(source), options.lidar_odometry);
+  if (source->info().odometry_is_ground_truth)
+    note(source->info().name +
+         ": its ground-truth poses serve as its odometry too (--odometry FILE or --odometry "
+         "lidar for odometry of its own): errors measured against them are marked so");
   if (!options.labels.empty())
-    source = withLabelSet(std::move(source), options.labels, options.class_maps_dir);
+    source = withLabelSet(std::move(source), options.labels, options.class_maps_dir,
+                          options.frames_to_check);
   if (options.semantics.model.empty()) return source;
   auto network = loadSegmentationNetwork(options.semantics, source->info(), options.class_maps_dir);
   return withSegmentationNetwork(std::move(source), std::move(network));
