@@ -130,7 +130,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"configs", "map-run"}},
     {"eval localization",
      {"world-seed", "out", "preset", "max-frames", "configs", "map-run", "query-runs",
-      "label-noise", "odometry"},
+      "label-noise", "odometry", "rig"},
      {"descriptors", "segmentation-run"}},
     {"eval revisits",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "map-frames",
