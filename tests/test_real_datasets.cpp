@@ -702,8 +702,12 @@ TEST(MiniKitti, PointsLandOnTheirPixels) {
       if (pc.z() > 20) far_road_v += uv->y(), ++far_road;
     }
     const double share = static_cast<double>(in_image) / f.points.size();
-    EXPECT_GT(share, 0.15) << sequence;  // about a quarter of a 360-degree scan
-    EXPECT_LT(share, 0.35) << sequence;
+    RecordProperty("in_image_share_" + sequence, std::to_string(share));
+    RecordProperty("road_grey_share_" + sequence, std::to_string(double(road_grey) / road));
+    // The picture spans 82 of the scan's 360 degrees of azimuth, and of the HDL-64E's rings (+2
+    // to -24.8 degrees) those down to -14.7: about a sixth of the scan (0.163 in both).
+    EXPECT_GT(share, 0.13) << sequence;
+    EXPECT_LT(share, 0.20) << sequence;
     ASSERT_GT(road, 1000u) << sequence;
     EXPECT_GT(static_cast<double>(road_grey) / road, 0.9) << sequence;  // asphalt is grey
     ASSERT_GT(near_road, 100u);
