@@ -3,7 +3,7 @@
 
     PYTHONPATH=build/python python3 examples/segment_overlap.py --map out/revisits/maps/X.map \\
         --dataset semantickitti:kitti_odometry_00_sparse --frames 24:30 \\
-        --config config/semsegmap-kitti.yaml
+        --config config/lidar-camera.yaml
 
 Builds the local map of --frames (one session, as `eval revisits` localizes them) on the
 dataset's ground-truth poses, so that the local segments lie where the map's do when the map was

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A descriptor model on a LiDAR without a camera, as models/MODEL_CARD.md measures every
 # candidate: map S0 of world seed 1 and localize S2 and S3 against it, rendered by the simulator
-# without cameras or classes for each LiDAR preset given, with config/semsegmap-kitti.yaml naming
+# without cameras or classes for each LiDAR preset given, with config/lidar-camera.yaml naming
 # MODEL as its descriptor.model_lidar_only (the model every command takes for such input).
 # Prints, per LiDAR, the localizations within 1 m and those more than 5 m off.
 #   scripts/eval_geometry_only.sh MODEL OUT_DIR LIDAR [LIDAR...]   (LIDAR: hdl64 vlp32 os128 solid paper)
@@ -14,7 +14,7 @@ bin=${SEMSEGMAP:-$root/build/semsegmap}
 mkdir -p "$out"
 config=$out/config.yaml
 sed -e "s|model: ../models/semsegmap-net.model.*|model: $root/models/semsegmap-net.model\n  model_lidar_only: $model|" \
-  "$root/config/semsegmap-kitti.yaml" > "$config"
+  "$root/config/lidar-camera.yaml" > "$config"
 grep -q "model_lidar_only: $model" "$config" || { echo "$config: could not name the model" >&2; exit 1; }
 for lidar in "$@"; do
   sim=sim:world=1,cameras=0,classes=0,lidar=$lidar

@@ -48,7 +48,7 @@ inline const std::filesystem::path kEspNet = std::filesystem::path(SEMSEGMAP_SHA
                                              "espnetv2_cityscapes_onnx" /
                                              "espnetv2_s2_city_384x1280.onnx";
 
-// DIR/espnet.yaml: the shipped real-data settings (`config_dir`/semsegmap-kitti.yaml up to its
+// DIR/espnet.yaml: the shipped real-data settings (`config_dir`/lidar-camera.yaml up to its
 // descriptor) with a semantics: section that runs ESPNetv2; its class map is the shipped
 // Cityscapes one plus the background channel, which is no class of ours.
 inline std::filesystem::path writeEspNetConfig(const std::filesystem::path& dir,
@@ -56,7 +56,7 @@ inline std::filesystem::path writeEspNetConfig(const std::filesystem::path& dir,
   std::ifstream map_in(config_dir / "class_maps" / "cityscapes.yaml");
   std::ofstream(dir / "espnet-classes.yaml")
       << map_in.rdbuf() << "  - {id: 19, name: background, class: unknown}\n";
-  std::ifstream config_in(config_dir / "semsegmap-kitti.yaml");
+  std::ifstream config_in(config_dir / "lidar-camera.yaml");
   const std::string settings((std::istreambuf_iterator<char>(config_in)),
                              std::istreambuf_iterator<char>());
   std::ofstream(dir / "espnet.yaml") << settings.substr(0, settings.find("descriptor:"))

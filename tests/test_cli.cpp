@@ -629,6 +629,190 @@ bool showsProgress(const std::string& text, const std::string& command) {
   return text.find(command + " [") != std::string::npos;
 }
 
+// The lines of `err` that are errors (the notes before them are not).
+size_t errorLines(const std::string& err) {
+  std::istringstream in(err);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) n += line.find(": error: ") != std::string::npos;
+  return n;
+}
+
+// The poses of a dataset directory's frames.csv (`odom_` or `gt_` columns) as a TUM file and as
+// a KITTI file (one line per frame, line N for frame N), and its times one per line.
+struct PoseFilesOf {
+  std::string tum, kitti, times;
+};
+PoseFilesOf poseFilesOf(const std::filesystem::path& dataset, const std::string& prefix) {
+  std::istringstream csv(readFile(dataset / "frames.csv"));
+  std::string line;
+  std::getline(csv, line);
+  std::vector<std::string> header;
+  std::istringstream names(line);
+  for (std::string name; std::getline(names, name, ',');) header.push_back(name);
+  const size_t first =
+      static_cast<size_t>(std::find(header.begin(), header.end(), prefix + "x") - header.begin());
+  PoseFilesOf files;
+  while (std::getline(csv, line)) {
+    std::vector<double> v;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) v.push_back(std::stod(cell));
+    const double x = v[first], y = v[first + 1], z = v[first + 2], qx = v[first + 3],
+                 qy = v[first + 4], qz = v[first + 5], qw = v[first + 6];
+    char text[512];
+    std::snprintf(text, sizeof(text), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", v[1], x, y, z,
+                  qx, qy, qz, qw);
+    files.tum += text;
+    std::snprintf(text, sizeof(text), "%.9f\n", v[1]);
+    files.times += text;
+    // The rotation matrix of the unit quaternion, row by row, each row followed by translation.
+    const double R[3][3] = {
+        {1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
+        {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
+        {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
+    const double t[3] = {x, y, z};
+    for (int r = 0; r < 3; ++r) {
+      std::snprintf(text, sizeof(text), "%.9f %.9f %.9f %.9f%s", R[r][0], R[r][1], R[r][2], t[r],
+                    r < 2 ? " " : "\n");
+      files.kitti += text;
+    }
+  }
+  return files;
+}
+
+// `--odometry FILE` and `--ground-truth FILE` as the README shows them, in KITTI and in TUM
+// format, on a folder of scans named by frame number with one of them missing (frames 0 and 2):
+// KITTI lines go by frame number, TUM poses by the times of a times file; each run says which
+// rule it used, and a file that fits none is refused in one line naming it.
+TEST(CliPoseFiles, MapAndLocalizeWithOdometryFilesInKittiAndTumFormat) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path data = copyOfDataset(tmp.path() / "data"), dir = tmp.path();
+  std::filesystem::remove(data / "lidar" / "000001.bin");
+  const PoseFilesOf odom = poseFilesOf(data, "odom_"), gt = poseFilesOf(data, "gt_");
+  std::ofstream(dir / "odom_kitti.txt") << odom.kitti;
+  std::ofstream(dir / "odom.tum") << odom.tum;
+  std::ofstream(dir / "gt_kitti.txt") << gt.kitti;
+  std::istringstream all_times(odom.times);
+  std::string t0, t1, t2;
+  all_times >> t0 >> t1 >> t2;
+  std::ofstream(dir / "times.txt") << t0 << "\n" << t2 << "\n";  // the scans that are left
+  const std::string config = " --config " + eigenConfig(dir, "eigen.yaml");
+  const std::string scans = " --dataset folder:" + (data / "lidar").string();
+  const std::string map = (dir / "m.map").string();
+
+  const Result m = run("map" + scans + " --odometry " + (dir / "odom_kitti.txt").string() + config +
+                       " --out " + map);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_NE(m.err.find("odom_kitti.txt: KITTI poses matched by frame number"), std::string::npos)
+      << m.err;
+  const Result l =
+      run("localize" + scans + ",times=" + (dir / "times.txt").string() + " --odometry " +
+          (dir / "odom.tum").string() + " --ground-truth " + (dir / "gt_kitti.txt").string() +
+          config + " --map " + map + " --out " + (dir / "loc").string());
+  ASSERT_EQ(l.code, 0) << l.err;
+  EXPECT_NE(l.err.find("odom.tum: TUM poses matched by time"), std::string::npos) << l.err;
+  const std::string summary = readFile(dir / "loc" / "summary.json");
+  EXPECT_NE(summary.find("\"has_ground_truth\": true"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"odometry_is_ground_truth\": false"), std::string::npos) << summary;
+
+  // TUM poses for scans whose names are frame numbers and no times file: no rule fits.
+  const Result tum = run("map" + scans + " --odometry " + (dir / "odom.tum").string() + config +
+                         " --out " + (dir / "m2.map").string());
+  EXPECT_EQ(tum.code, 1);
+  EXPECT_EQ(errorLines(tum.err), 1u) << tum.err;
+  EXPECT_NE(tum.err.find("odom.tum: TUM poses are matched to scans by time"), std::string::npos)
+      << tum.err;
+  // Two KITTI lines for scans up to frame 2.
+  std::ofstream(dir / "short.txt")
+      << odom.kitti.substr(0, odom.kitti.find('\n') + 1) + "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  const Result few = run("map" + scans + " --odometry " + (dir / "short.txt").string() + config +
+                         " --out " + (dir / "m3.map").string());
+  EXPECT_EQ(few.code, 1);
+  EXPECT_NE(few.err.find("short.txt: 2 KITTI poses, but the scans go up to frame 2"),
+            std::string::npos)
+      << few.err;
+}
+
+// The segmentation network of the tests (tests' colour4.onnx) in a config, with its class map.
+std::string networkConfig(const std::filesystem::path& dir) {
+  std::ofstream(dir / "colour.yaml")
+      << "name: colour4\nclasses:\n  - {id: 0, name: red, class: building}\n"
+         "  - {id: 1, name: green, class: vegetation}\n  - {id: 2, name: blue, class: sky}\n"
+         "  - {id: 3, name: dark, class: road}\n";
+  std::ofstream(dir / "net.yaml") << "semantics:\n  model: " SEMSEGMAP_ONNX_DIR
+                                     "/colour4.onnx\n"
+                                     "  class_map: colour.yaml\n  mean: [0, 0, 0]\n"
+                                     "  std: [1, 1, 1]\n  replace_dataset_labels: true\n";
+  return (dir / "net.yaml").string();
+}
+
+// `label --max-frames 1` records the one frame it labelled, and `map --labels` refuses the set
+// unless it reads no more; a `label` stopped half way leaves no labels.yaml, even where an
+// earlier whole set was.
+TEST(CliLabelSets, ASetRecordsTheFramesItLabelledAndAStoppedRunLeavesNoneWhole) {
+  if (!built("simulate")) GTEST_SKIP() << "the pictures come from the simulator";
+  TempDir tmp;
+  const std::filesystem::path dir = tmp.path(), labels = dir / "labels";
+  const std::string net = networkConfig(dir);
+  const std::string data = " --dataset sim:preset=tiny,frames=2";
+  const Result r =
+      run("label" + data + " --config " + net + " --out " + labels.string() + " --max-frames 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string yaml = readFile(labels / "labels.yaml");
+  EXPECT_NE(yaml.find("frames: 1\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("dataset_frames: 2\n"), std::string::npos) << yaml;
+  const std::string map =
+      " --config " + eigenConfig(dir, "eigen.yaml") + " --labels " + labels.string() + " --out ";
+  const Result all = run("map" + data + map + (dir / "all.map").string());
+  EXPECT_EQ(all.code, 1);
+  EXPECT_EQ(lines(all.err), 1u) << all.err;
+  EXPECT_NE(all.err.find(labels.string() + ": the label set labels frames 0 to 0 only"),
+            std::string::npos)
+      << all.err;
+  const Result one = run("map" + data + map + (dir / "one.map").string() + " --max-frames 1");
+  EXPECT_EQ(one.code, 0) << one.err;
+
+  // A whole set, then a run over it that fails at its last frame's picture.
+  const std::filesystem::path copy = copyOfDataset(dir / "data");
+  const std::string label =
+      "label --dataset " + copy.string() + " --config " + net + " --out " + labels.string();
+  ASSERT_EQ(run(label).code, 0);
+  ASSERT_TRUE(std::filesystem::exists(labels / "labels.yaml"));
+  // Its header stays (the up-front check reads the size), its pixels are cut off.
+  const std::filesystem::path picture = copy / "cam0" / "000002.png";
+  std::filesystem::resize_file(picture, std::filesystem::file_size(picture) / 2);
+  const Result stopped = run(label);
+  EXPECT_EQ(stopped.code, 1) << stopped.err;
+  EXPECT_FALSE(std::filesystem::exists(labels / "labels.yaml"));
+  const Result refused = run("map --dataset " + copy.string() + map + (dir / "x.map").string());
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_NE(refused.err.find("labels.yaml: missing"), std::string::npos) << refused.err;
+}
+
+// One file as odometry and ground truth: the run says so, and its errors are marked.
+TEST(CliPoseFiles, GroundTruthAsOdometryIsSaidAndMarked) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path data = copyOfDataset(tmp.path() / "data"), dir = tmp.path();
+  std::ofstream(dir / "gt.txt") << poseFilesOf(data, "gt_").kitti;
+  const std::string config = " --config " + eigenConfig(dir, "eigen.yaml");
+  const std::string posed = " --dataset folder:" + (data / "lidar").string() + " --odometry " +
+                            (dir / "gt.txt").string() + " --ground-truth " +
+                            (dir / "gt.txt").string();
+  const std::string map = (dir / "m.map").string();
+  ASSERT_EQ(run("map" + posed + config + " --out " + map).code, 0);
+  const Result l =
+      run("localize" + posed + config + " --map " + map + " --out " + (dir / "loc").string());
+  ASSERT_EQ(l.code, 0) << l.err;
+  EXPECT_NE(l.err.find("ground-truth poses serve as its odometry too"), std::string::npos) << l.err;
+  const std::string summary = readFile(dir / "loc" / "summary.json");
+  EXPECT_NE(summary.find("\"odometry_is_ground_truth\": true"), std::string::npos) << summary;
+  if (summary.find("\"n_localizations\": 0") == std::string::npos) {  // errors printed: marked
+    EXPECT_NE(l.out.find("[errors against the ground truth used as odometry]"), std::string::npos)
+        << l.out;
+  }
+}
+
 // map --out naming a directory or an unwritable place used to fail after every frame.
 TEST(CliUpFront, OutputsOfTheWrongKindOrUnwritableFailBeforeFrame0) {
   if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
@@ -773,7 +957,7 @@ class CliMaps : public ::testing::Test {
 };
 
 // `map` without --points keeps the points its configuration asks for, so that a configuration
-// that refines poses (config/semsegmap-kitti.yaml) builds maps its own localization accepts.
+// that refines poses (config/lidar-camera.yaml) builds maps its own localization accepts.
 TEST_F(CliMaps, MapKeepsTheConfiguredSegmentPointsUnlessPointsIsGiven) {
   const std::string refine =
       eigenConfig(tmp_.path(), "refine.yaml",
@@ -915,7 +1099,7 @@ TEST(CliEvalRevisits, RunsOnTheRealKittiScansInEveryBuild) {
   if (!std::filesystem::exists(kitti / "poses.txt"))
     GTEST_SKIP() << "no real KITTI sample (" << kitti.string() << ")";
   TempDir tmp;
-  std::string settings = readFile("config/semsegmap-kitti.yaml");  // ctest runs in the source tree
+  std::string settings = readFile("config/lidar-camera.yaml");  // ctest runs in the source tree
   settings = settings.substr(0, settings.find("descriptor:")) + "descriptor:\n  kind: eigen\n" +
              settings.substr(settings.find("localization:"));
   const std::filesystem::path config = tmp.path() / "eigen-kitti.yaml", out = tmp.path() / "rev";
@@ -929,6 +1113,13 @@ TEST(CliEvalRevisits, RunsOnTheRealKittiScansInEveryBuild) {
   const std::string json = readFile(out / "revisits.json");
   EXPECT_NE(json.find("\"n_queries\": 12"), std::string::npos) << json.substr(0, 600);
   EXPECT_NE(json.find("\"n_revisits\": 3"), std::string::npos) << json.substr(0, 600);
+  // The sequence's poses are its odometry too: said on stderr, marked in the table and files.
+  EXPECT_NE(r.err.find("ground-truth poses serve as its odometry too"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("[odometry is the ground truth]"), std::string::npos) << r.out;
+  EXPECT_NE(json.find("\"odometry_is_ground_truth\": true"), std::string::npos);
+  EXPECT_NE(
+      readFile(out / "eigen-kitti" / "summary.json").find("\"odometry_is_ground_truth\": true"),
+      std::string::npos);
   EXPECT_GT(std::filesystem::file_size(out / "revisits.png"), 1000u);
 }
 
@@ -946,7 +1137,7 @@ TEST(CliEvalSemantics, LabelsThenEvalOnTheRealMiniKitti) {
   Result r = run("label" + dataset + " --config " + net.string() + " --out " + labels.string());
   ASSERT_EQ(r.code, 0) << r.err;
   r = run("eval semantics" + dataset + " --labels " + labels.string() +
-          " --config config/semsegmap-kitti.yaml --out " + out.string());
+          " --config config/lidar-camera.yaml --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("  after votes "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("map segments with a class: "), std::string::npos) << r.out;
@@ -954,8 +1145,7 @@ TEST(CliEvalSemantics, LabelsThenEvalOnTheRealMiniKitti) {
   EXPECT_NE(json.find("\"frames\": 10"), std::string::npos) << json.substr(0, 600);
   EXPECT_NE(json.find("\"after_votes\""), std::string::npos);
   // Without a label set or a network there is nothing to measure: one line naming the frame.
-  r = run("eval semantics" + dataset + " --config config/semsegmap-kitti.yaml --out " +
-          out.string());
+  r = run("eval semantics" + dataset + " --config config/lidar-camera.yaml --out " + out.string());
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("frame 0 has no label image in any camera"), std::string::npos) << r.err;
 }

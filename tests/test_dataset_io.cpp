@@ -167,6 +167,7 @@ void expectSameInfo(const DatasetInfo& a, const DatasetInfo& b) {
   EXPECT_EQ(a.name, b.name);
   EXPECT_EQ(a.has_ground_truth_poses, b.has_ground_truth_poses);
   EXPECT_EQ(a.has_odometry, b.has_odometry);
+  EXPECT_EQ(a.odometry_is_ground_truth, b.odometry_is_ground_truth);
   EXPECT_EQ(a.has_point_labels, b.has_point_labels);
   EXPECT_TRUE(a.classes == b.classes);
   EXPECT_EQ(a.rig.rate_hz, b.rig.rate_hz);
@@ -215,6 +216,19 @@ TEST(DatasetIo, RoundTripGivesIdenticalFramesAndInfo) {
   ASSERT_EQ(reader.size(), written.size());
   for (size_t i = 0; i < written.size(); ++i) expectSameFrame(written[i], reader.frame(i));
   EXPECT_TRUE(temporaryFilesUnder(tmp.path()).empty());
+}
+
+// A dataset converted from one whose odometry is its ground truth keeps saying so.
+TEST(DatasetIo, OdometryThatIsTheGroundTruthStaysMarked) {
+  TempDir tmp;
+  DatasetInfo info = tinyInfo();
+  writeMetaYaml(tmp.path() / "meta.yaml", info);
+  EXPECT_EQ(readFileBytes(tmp.path() / "meta.yaml").find("odometry_is_ground_truth"),
+            std::string::npos);  // absent when false: older builds read the file as before
+  EXPECT_FALSE(readMetaYaml(tmp.path() / "meta.yaml").odometry_is_ground_truth);
+  info.odometry_is_ground_truth = true;
+  writeMetaYaml(tmp.path() / "meta.yaml", info);
+  EXPECT_TRUE(readMetaYaml(tmp.path() / "meta.yaml").odometry_is_ground_truth);
 }
 
 TEST(DatasetIo, FilesFollowTheDocumentedLayout) {

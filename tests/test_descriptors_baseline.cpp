@@ -34,6 +34,7 @@ EnrichedPoint point(const Eigen::Vector3d& p) {
   q.h = 0.2f;
   q.s = q.v = 0.5f;
   q.has_color = true;
+  q.has_class = true;
   q.class_id = cls::kBuilding;
   return q;
 }

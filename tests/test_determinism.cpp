@@ -61,7 +61,7 @@ std::vector<semsegmap::EnrichedCloud> randomSegments(int count) {
     semsegmap::EnrichedCloud cloud(static_cast<size_t>(100 + 13 * i));
     for (semsegmap::EnrichedPoint& p : cloud) {
       p.x = 2 * u(rng), p.y = 2 * u(rng), p.z = 2 * u(rng);
-      p.h = u(rng), p.s = u(rng), p.v = u(rng), p.has_color = true;
+      p.h = u(rng), p.s = u(rng), p.v = u(rng), p.has_color = p.has_class = true;
       p.class_id = static_cast<semsegmap::ClassId>(1 + i % 5);
     }
     segments.push_back(std::move(cloud));

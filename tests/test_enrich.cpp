@@ -102,8 +102,10 @@ void expectColourOf(const EnrichedPoint& p, const Image& rgb, int x, int y) {
   EXPECT_FLOAT_EQ(p.v, v);
 }
 
+// Unobserved: no colour and no class, which is not the class unknown.
 void expectNothing(const EnrichedPoint& p) {
   EXPECT_FALSE(p.has_color);
+  EXPECT_FALSE(p.has_class);
   EXPECT_EQ(p.class_id, cls::kUnknown);
   EXPECT_EQ(p.h, 0.0f);
   EXPECT_EQ(p.s, 0.0f);
@@ -230,7 +232,7 @@ TEST(Enrich, HugeCameraIsRefusedBeforeItsZBufferIsAllocated) {
   EXPECT_EQ(enrichFrame(f, rig, EnrichmentConfig{}).size(), 1u);
 }
 
-TEST(Enrich, PointsBehindOrOutsideGetUnknownAndNoColour) {
+TEST(Enrich, PointsBehindOrOutsideAreUnobserved) {
   SensorRig rig;
   rig.cameras = {makeCamera("cam")};
   Frame f;
@@ -246,7 +248,14 @@ TEST(Enrich, PointsBehindOrOutsideGetUnknownAndNoColour) {
     expectNothing(cloud[i]);
   }
   EXPECT_TRUE(cloud[4].has_color);
+  EXPECT_TRUE(cloud[4].has_class);
   EXPECT_NE(cloud[4].class_id, cls::kUnknown);
+  // A pixel the network called unknown gives the class unknown: observed, not unobserved.
+  f.cameras = {uniformImages(rig.cameras[0], 10, 20, 30, cls::kUnknown)};
+  const EnrichedCloud unknown = enrichFrame(f, rig, EnrichmentConfig{});
+  EXPECT_TRUE(unknown[4].has_class);
+  EXPECT_EQ(unknown[4].class_id, cls::kUnknown);
+  expectNothing(unknown[0]);
 }
 
 TEST(Enrich, PointSeenByTwoCamerasTakesTheNearerImageCentre) {
@@ -384,6 +393,7 @@ TEST(Enrich, WithoutLabelImagesClassesComeFromPointLabels) {
   EXPECT_EQ(cloud[0].instance_id, 17);
   // Labels belong to the points, so they hold outside the cameras too.
   EXPECT_FALSE(cloud[1].has_color);
+  EXPECT_TRUE(cloud[1].has_class);
   EXPECT_EQ(cloud[1].class_id, cls::kVegetation);
 
   // No images at all: classes and instances from the points, no colour.
@@ -392,6 +402,11 @@ TEST(Enrich, WithoutLabelImagesClassesComeFromPointLabels) {
   EXPECT_FALSE(bare[0].has_color);
   EXPECT_EQ(bare[0].class_id, cls::kPole);
   EXPECT_EQ(bare[0].instance_id, 17);
+  // Point labels that carry instances alone (all of class unknown) give no class.
+  f.point_labels = {PointLabel{cls::kUnknown, 17}, PointLabel{cls::kUnknown, 0}};
+  const EnrichedCloud instances_only = enrichFrame(f, rig, EnrichmentConfig{});
+  EXPECT_FALSE(instances_only[0].has_class);
+  EXPECT_EQ(instances_only[0].instance_id, 17);
 }
 
 TEST(Enrich, LabelImagesWinOverPointLabelsButInstancesAreCopied) {
@@ -404,7 +419,8 @@ TEST(Enrich, LabelImagesWinOverPointLabelsButInstancesAreCopied) {
   const EnrichedCloud cloud = enrichFrame(f, rig, EnrichmentConfig{});
   EXPECT_EQ(cloud[0].class_id, cls::kRoad);
   EXPECT_EQ(cloud[0].instance_id, 3);
-  EXPECT_EQ(cloud[1].class_id, cls::kUnknown);  // the camera semantics do not reach it
+  EXPECT_FALSE(cloud[1].has_class);  // the camera semantics do not reach it
+  EXPECT_EQ(cloud[1].class_id, cls::kUnknown);
   EXPECT_EQ(cloud[1].instance_id, 4);
 }
 
@@ -668,6 +684,35 @@ TEST(EnrichSim, CameraClassesAgreeWithGroundTruthPointLabels) {
             << " with a wrong class; with it: " << coloured_total << ", " << wrong << "\n";
   EXPECT_LT(wrong, 0.8 * wrong_without);
   EXPECT_GT(coloured_total, 0.97 * coloured_without);
+}
+
+// The commonest real rig: one front camera on a 360-degree LiDAR. A quarter of the scan is in
+// the picture, with a class; the rest is unobserved, never class unknown.
+TEST(EnrichSim, AFrontCameraOnA360DegreeLidarLeavesMostPointsUnobserved) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  auto source = openDataset("sim:world=1,run=S2,preset=tiny,frames=1,lidar=hdl64,cameras=front");
+  ASSERT_EQ(source->info().rig.cameras.size(), 1u);
+  EXPECT_EQ(source->info().rig.cameras[0].name, "front");
+  const Frame frame = source->frame(0);
+  ASSERT_EQ(frame.cameras.size(), 1u);
+  const EnrichedCloud cloud = enrichFrame(frame, source->info().rig, EnrichmentConfig{});
+  size_t classified = 0;
+  for (const EnrichedPoint& p : cloud) {
+    classified += p.has_class;
+    if (!p.has_class) {
+      EXPECT_FALSE(p.has_color);
+    }
+  }
+  const double share = static_cast<double>(classified) / static_cast<double>(cloud.size());
+  std::cout << "front camera: " << classified << " of " << cloud.size() << " points have a class\n";
+  EXPECT_GT(share, 0.12);
+  EXPECT_LT(share, 0.40);
+  try {
+    openDataset("sim:world=1,run=S2,preset=tiny,cameras=back");
+    ADD_FAILURE() << "a camera the rig lacks was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "simulator: no camera 'back' on the rig (left, front, right)");
+  }
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "error_text.h"
 #include "fuzz_regressions.h"
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/core/sensor_rig.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/enrich/enricher.h"
@@ -27,6 +28,7 @@
 #include "semsegmap/io/kitti_calib.h"
 #include "semsegmap/io/point_cloud_file.h"
 #include "semsegmap/io/rig_file.h"
+#include "semsegmap/io/semantic_kitti_reader.h"
 #include "semsegmap/io/trajectory_file.h"
 #include "semsegmap/pipeline/pipeline.h"
 #include "temp_dir.h"
@@ -580,6 +582,177 @@ TEST(PoseFiles, ARunWithoutOdometryIsRefusedUpFront) {
   const std::string error = errorOf(
       [&] { Pipeline pipe(PipelineConfig{}, source->info(), PoseSource::kOdometry, nullptr); });
   EXPECT_NE(error.find("has no odometry: give --odometry FILE"), std::string::npos) << error;
+}
+
+namespace {
+
+// A LiDAR-only folder whose scans are named by the frame numbers given (`digits` wide: 6 as in
+// KITTI, 0 for plain numbers); each scan's single point lies at x = its frame number.
+fs::path writeNumberedScans(const fs::path& dir, const std::vector<size_t>& numbers,
+                            int digits = 6) {
+  fs::create_directories(dir);
+  for (const size_t n : numbers) {
+    char stem[32];
+    std::snprintf(stem, sizeof(stem), "%0*zu", digits, n);
+    writeLidarBin(dir / (std::string(stem) + ".bin"), {{static_cast<float>(n), 0.0f, 0.0f, 0.0f}});
+  }
+  return dir;
+}
+
+// KITTI poses, one line per frame: the pose of frame N lies at x = N.
+void writeKittiPosesAlongX(const fs::path& path, size_t lines) {
+  std::string text;
+  for (size_t n = 0; n < lines; ++n) text += "1 0 0 " + std::to_string(n) + " 0 1 0 0 0 0 1 0\n";
+  writeText(path, text);
+}
+
+// The notes and warnings that `f` gives.
+std::vector<std::string> messagesOf(const std::function<void()>& f) {
+  std::vector<std::string> lines;
+  setMessageSink([&](const std::string& line) { lines.push_back(line); });
+  try {
+    f();
+  } catch (...) {
+    setMessageSink({});
+    throw;
+  }
+  setMessageSink({});
+  return lines;
+}
+
+bool saysOnce(const std::vector<std::string>& lines, const std::string& text) {
+  return std::count_if(lines.begin(), lines.end(), [&](const std::string& l) {
+           return l.find(text) != std::string::npos;
+         }) == 1;
+}
+
+}  // namespace
+
+// KITTI's full poses.txt beside sparse scans: scan 000120 takes line 120, not line 3.
+TEST(PoseFiles, KittiLineNBelongsToTheScanNamedN) {
+  for (const int digits : {6, 0}) {  // 000038.bin and 38.bin alike (38 sorts after 120 by name)
+    TempDir tmp;
+    const fs::path dir = writeNumberedScans(tmp.path() / "scans", {0, 38, 79, 120}, digits);
+    writeKittiPosesAlongX(tmp.path() / "poses.txt", 121);
+    DatasetOptions options;
+    options.ground_truth = tmp.path() / "poses.txt";
+    options.odometry = tmp.path() / "poses.txt";
+    std::unique_ptr<FrameSource> source;
+    const auto lines = messagesOf([&] { source = openDataset("folder:" + dir.string(), options); });
+    ASSERT_EQ(source->size(), 4u);
+    const double expected[] = {0, 38, 79, 120};
+    for (size_t i = 0; i < 4; ++i) {
+      const Frame f = source->frame(i);
+      EXPECT_EQ(source->frameNumber(i), static_cast<size_t>(expected[i]));
+      EXPECT_FLOAT_EQ(f.points.at(0).x, static_cast<float>(expected[i])) << "scan order";
+      EXPECT_NEAR(f.T_world_base->translation().x(), expected[i], 1e-12) << "digits " << digits;
+      EXPECT_NEAR(f.T_odom_base.translation().x(), expected[i], 1e-12);
+    }
+    EXPECT_NEAR(source->frameTime(3), 12.0, 1e-9);  // frame 120 at 10 Hz
+    EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
+                            [](const std::string& l) {
+                              return l.find("poses.txt: KITTI poses matched by frame number") !=
+                                     std::string::npos;
+                            }),
+              2)  // one line per pose file given
+        << ::testing::PrintToString(lines);
+    // One file for both: odometry is the ground truth, said once and marked.
+    EXPECT_TRUE(source->info().odometry_is_ground_truth);
+    EXPECT_TRUE(saysOnce(lines, "ground-truth poses serve as its odometry too"))
+        << ::testing::PrintToString(lines);
+  }
+}
+
+TEST(PoseFiles, KittiPosesShortOfTheLargestFrameAreRefused) {
+  TempDir tmp;
+  const fs::path dir = writeNumberedScans(tmp.path() / "scans", {0, 38, 79, 120});
+  writeKittiPosesAlongX(tmp.path() / "poses.txt", 120);  // lines 0..119: no line for 120
+  DatasetOptions options;
+  options.ground_truth = tmp.path() / "poses.txt";
+  const std::string error = errorOf([&] { openDataset("folder:" + dir.string(), options); });
+  EXPECT_NE(error.find((tmp.path() / "poses.txt").string() +
+                       ": 120 KITTI poses, but the scans go up to frame 120"),
+            std::string::npos)
+      << error;
+}
+
+// Scans named by frame number have no times of their own: TUM poses need a times file.
+TEST(PoseFiles, TumPosesNeedScanTimesFromTheData) {
+  TempDir tmp;
+  const fs::path dir = writeNumberedScans(tmp.path() / "scans", {0, 5, 10});
+  writeText(tmp.path() / "odom.tum", "100.0 0 0 0 0 0 0 1\n101.0 2 0 0 0 0 0 1\n");
+  DatasetOptions options;
+  options.odometry = tmp.path() / "odom.tum";
+  const std::string error = errorOf([&] { openDataset("folder:" + dir.string(), options); });
+  EXPECT_NE(error.find("odom.tum: TUM poses are matched to scans by time, but the scans of"),
+            std::string::npos)
+      << error;
+  writeText(tmp.path() / "times.txt", "100.0\n100.5\n101.0\n");
+  std::unique_ptr<FrameSource> source;
+  const auto lines = messagesOf([&] {
+    source = openDataset("folder:" + dir.string() + ",times=" + (tmp.path() / "times.txt").string(),
+                         options);
+  });
+  ASSERT_EQ(source->size(), 3u);
+  EXPECT_NEAR(source->frame(1).T_odom_base.translation().x(), 1.0, 1e-9);  // 100.5 s: half way
+  EXPECT_NEAR(source->frame(2).T_odom_base.translation().x(), 2.0, 1e-9);
+  EXPECT_FALSE(source->info().odometry_is_ground_truth);
+  EXPECT_TRUE(saysOnce(lines, "odom.tum: TUM poses matched by time"))
+      << ::testing::PrintToString(lines);
+}
+
+// Names that are no frame numbers: KITTI lines in order only with one line per scan.
+TEST(PoseFiles, KittiPosesForScansWithoutNumbersMustCountTheScans) {
+  TempDir tmp;
+  const fs::path dir = tmp.path() / "scans";
+  fs::create_directories(dir);
+  for (const char* name : {"scan_a", "scan_b", "scan_c"})
+    writeLidarBin(dir / (std::string(name) + ".bin"), {{1.0f, 0.0f, 0.0f, 0.0f}});
+  writeKittiPosesAlongX(tmp.path() / "poses.txt", 4);
+  DatasetOptions options;
+  options.ground_truth = tmp.path() / "poses.txt";
+  const std::string error = errorOf([&] { openDataset("folder:" + dir.string(), options); });
+  EXPECT_NE(error.find("poses.txt: 4 KITTI poses for 3 scans whose names are no frame numbers"),
+            std::string::npos)
+      << error;
+  writeKittiPosesAlongX(tmp.path() / "poses.txt", 3);
+  std::unique_ptr<FrameSource> source;
+  const auto lines = messagesOf([&] { source = openDataset("folder:" + dir.string(), options); });
+  EXPECT_NEAR(source->frame(2).T_world_base->translation().x(), 2.0, 1e-12);
+  EXPECT_TRUE(saysOnce(lines, "poses.txt: KITTI poses taken in scan order"))
+      << ::testing::PrintToString(lines);
+  // Nor do such names give times to match TUM poses to.
+  writeText(tmp.path() / "gt.tum", "0.0 0 0 0 0 0 0 1\n1.0 4 0 0 0 0 0 1\n");
+  options.ground_truth = tmp.path() / "gt.tum";
+  EXPECT_NE(errorOf([&] {
+              openDataset("folder:" + dir.string(), options);
+            }).find("gt.tum: TUM poses are matched to scans by time"),
+            std::string::npos);
+}
+
+// KITTI 00's sparse scans as a folder with the sequence's full poses.txt: every scan gets the
+// pose of its own frame number, as semantickitti: gives it (scan 000120 about 89 m out, not at
+// the 2.6 m of line 4).
+TEST(RealSamples, SparseKittiScansTakeThePoseOfTheirFrameNumber) {
+  const fs::path dir = kShared / "kitti_odometry_00_sparse";
+  if (!fs::exists(dir / "poses.txt"))
+    GTEST_SKIP() << "the real sparse KITTI 00 sample is absent (" << dir.string()
+                 << "): ../shared/data is not beside this checkout";
+  DatasetOptions options;
+  options.ground_truth = dir / "poses.txt";  // camera-0 poses; calib.txt beside it says Tr
+  auto folder = openDataset("folder:" + (dir / "velodyne").string(), options);
+  SemanticKittiReader sequence(dir);
+  ASSERT_EQ(folder->size(), sequence.size());
+  std::optional<size_t> frame120;
+  for (size_t i = 0; i < folder->size(); ++i) {
+    ASSERT_EQ(folder->frameNumber(i), sequence.frameNumber(i));
+    if (folder->frameNumber(i) == 120u) frame120 = i;
+  }
+  ASSERT_TRUE(frame120.has_value()) << "the sample's README lists frame 120";
+  const Frame f = folder->frame(*frame120), g = sequence.frame(*frame120);
+  ASSERT_TRUE(f.T_world_base && g.T_world_base);
+  EXPECT_LT((f.T_world_base->translation() - g.T_world_base->translation()).norm(), 1e-6);
+  EXPECT_GT(f.T_world_base->translation().norm(), 50.0);
 }
 
 // ------------------------------------------------------------------------------------------

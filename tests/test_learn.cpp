@@ -31,6 +31,7 @@ EnrichedCloud randomCloud(size_t n, uint32_t seed, ClassId class_id = cls::kBuil
     p.x = 10.0f + 4.0f * u(rng), p.y = -5.0f + 2.0f * u(rng), p.z = 3.0f * u(rng);
     p.h = u(rng), p.s = u(rng), p.v = u(rng);
     p.has_color = true;
+    p.has_class = true;
     p.class_id = class_id;
   }
   return cloud;
@@ -56,7 +57,7 @@ TrainingSet syntheticSet(int instances, int per_instance) {
       for (const auto& p : c) {
         o.xyzhsv.insert(o.xyzhsv.end(), {p.x, p.y, p.z, p.h, p.s, p.v});
         o.classes.push_back(p.class_id);
-        o.colored.push_back(1);
+        o.modalities.push_back(TrainingObservation::kHasColor | TrainingObservation::kHasClass);
       }
       o.n_points = 20;
       o.purity = 1.0f;
@@ -376,7 +377,7 @@ TEST(TrainingData, CacheRoundTripsAndKnowsWhatItWasMadeFrom) {
     EXPECT_EQ(x.source, y.source);
     EXPECT_EQ(x.xyzhsv, y.xyzhsv);
     EXPECT_EQ(x.classes, y.classes);
-    EXPECT_EQ(x.colored, y.colored);
+    EXPECT_EQ(x.modalities, y.modalities);
   }
   EXPECT_FALSE(readTrainingCache(path, "made from B").has_value());
   EXPECT_FALSE(readTrainingCache(path.string() + ".missing", "made from A").has_value());
@@ -618,7 +619,7 @@ TEST_F(SimulatedData, AStudentStartsFromItsTeachersWeights) {
     for (size_t i = 0; i < o.size(); ++i) {
       std::fill_n(o.xyzhsv.begin() + static_cast<std::ptrdiff_t>(6 * i + 3), 3, 0.0f);
       o.classes[i] = cls::kUnknown;
-      o.colored[i] = 0;
+      o.modalities[i] = 0;
     }
   const std::vector<size_t> some = {0, 5, 10};
   const Eigen::MatrixXf s = describeObservations(*result.net, grey, some, 3);

@@ -37,7 +37,7 @@ EnrichedCloud makeShape(int shape, int n, uint64_t seed) {
   std::normal_distribution<float> g(0.0f, 1.0f);
   EnrichedCloud cloud(static_cast<size_t>(n));
   for (EnrichedPoint& p : cloud) {
-    p.has_color = true;
+    p.has_color = p.has_class = true;
     switch (shape) {
       case 0: {  // box 2 x 1.2 x 1.5, its six faces
         const int face = static_cast<int>(u(rng) * 6) % 6;
@@ -223,6 +223,25 @@ TEST(NetInput, SubsampleIsAFunctionOfThePointSet) {
   const std::vector<uint32_t> all = hashSubsample(cloud, 2000, 7);
   EXPECT_EQ(std::set<uint32_t>(all.begin(), all.begin() + 900).size(), 900u);
   EXPECT_TRUE(std::equal(all.begin(), all.begin() + 900, all.begin() + 900));
+}
+
+// A segment half in the picture: the unobserved half is missing from the class histograms, not
+// a vote for unknown, so every cell that holds a point with a class is all car, and the cells of
+// unobserved points alone are empty.
+TEST(NetInput, UnobservedPointsAreMissingFromTheClassHistograms) {
+  EnrichedCloud car = makeShape(0, 700, 1);
+  for (size_t i = 0; i < car.size(); ++i)
+    if (car[i].x > 1.0f) car[i].has_class = false;
+  NetConfig config;
+  std::mt19937 rng(1);
+  const NetInput in = makeNetInput(config, {&car}, rng);
+  const torch::Tensor sums = in.class_grid[0].sum(0);
+  EXPECT_EQ(in.class_grid[0][cls::kUnknown].sum().item<float>(), 0.0f);
+  EXPECT_NEAR(in.class_grid[0][cls::kCar].sum().item<float>(), (sums > 0).sum().item<float>(),
+              1e-4);
+  // The box's far half (x > 1 of 2 m) fills the grid's last third of cells along x: empty.
+  EXPECT_EQ(in.class_grid[0].narrow(1, 2, 1).sum().item<float>(), 0.0f);
+  EXPECT_GT(in.class_grid[0].narrow(1, 0, 1).sum().item<float>(), 0.0f);
 }
 
 TEST(NetInput, ShapesAndRanges) {

@@ -19,8 +19,39 @@ EnrichedPoint point(float x, float y, float z, ClassId c = cls::kBuilding, float
   p.s = 0.5f;
   p.v = 0.5f;
   p.class_id = c;
+  p.has_class = true;
   p.has_color = colored;
   return p;
+}
+
+// A point no camera saw: geometry alone.
+EnrichedPoint unobserved(float x, float y, float z) {
+  EnrichedPoint p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  return p;
+}
+
+// Road under x (its class removes it): unobserved points above it are not its ground.
+EnrichedPoint road(float x) {
+  return point(x, 0.05f, 0.0f, cls::kRoad);
+}
+
+// A 6 x 6 m patch of ground at z = 0 (10 cm apart) and a 2 m high wall standing on it at x = 2.
+EnrichedCloud groundAndWall(bool observed) {
+  EnrichedCloud scan;
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 60; ++j) {
+      const float x = -3.0f + 0.1f * i + 0.05f, y = -3.0f + 0.1f * j + 0.05f;
+      scan.push_back(observed ? point(x, y, 0.0f, cls::kRoad) : unobserved(x, y, 0.0f));
+    }
+  for (int j = 0; j < 20; ++j)
+    for (int k = 1; k <= 20; ++k) {
+      const float y = -1.0f + 0.1f * j + 0.05f, z = 0.1f * k;
+      scan.push_back(observed ? point(2.05f, y, z, cls::kBuilding) : unobserved(2.05f, y, z));
+    }
+  return scan;
 }
 
 LocalMap makeMap(LocalMapConfig c = {}) {
@@ -189,4 +220,77 @@ TEST(GroundRemoval, FollowsATiltedGroundWithoutAFixedHeight) {
   EXPECT_EQ(object_hits, 0u);
   // A fixed height threshold would have removed the box (it stands 2 m above the origin's ground).
   EXPECT_GT(slope * 15.0, 2.0);
+}
+
+// A point no camera saw is not of class unknown: it keeps its geometry, votes for no class, and
+// its voxel takes the class of the frames in which a camera sees it (the front camera of a car
+// sees a place before the LiDAR sweeps past it from the side).
+TEST(LocalMap, UnobservedPointsKeepTheirGeometryAndTakeTheirClassFromLaterFrames) {
+  LocalMap map = makeMap();
+  const LocalMapUpdate u = map.update(
+      {road(5.05f), unobserved(5.05f, 0.05f, 1.05f), point(8.05f, 0.05f, 1.05f, cls::kBuilding)},
+      Pose::Identity(), {0, 0});
+  EXPECT_EQ(u.points_inserted, 2u);
+  EXPECT_EQ(u.points_unobserved, 1u);
+  const VoxelKey seen_later = packVoxelKey({50, 0, 10});
+  ASSERT_NE(map.find(seen_later), nullptr);
+  EXPECT_TRUE(map.find(seen_later)->active);
+  EXPECT_FALSE(map.find(seen_later)->hasClass());
+  EXPECT_EQ(map.find(seen_later)->n_classified, 0u);
+  map.update({road(5.05f), point(5.05f, 0.05f, 1.05f, cls::kFence)}, Pose::Identity(), {0, 0});
+  EXPECT_TRUE(map.find(seen_later)->hasClass());
+  EXPECT_EQ(map.find(seen_later)->semanticClass(), cls::kFence);
+  // And it keeps that class when later frames see it unobserved again.
+  map.update({road(5.05f), unobserved(5.05f, 0.05f, 1.05f), unobserved(5.05f, 0.05f, 1.05f)},
+             Pose::Identity(), {0, 0});
+  EXPECT_EQ(map.find(seen_later)->semanticClass(), cls::kFence);
+  EXPECT_EQ(map.find(seen_later)->n_points, 4u);
+}
+
+// remove_unknown_class drops what the network called unknown, never what no camera saw; the
+// paper's rig may still drop unobserved points of scans that have classes (remove_unobserved).
+TEST(LocalMap, UnknownClassAndUnobservedAreFilteredByTheirOwnSettings) {
+  EnrichedPoint network_unknown = point(5.05f, 0.05f, 1.05f, cls::kUnknown);
+  const EnrichedCloud scan = {road(6.05f), network_unknown, unobserved(6.05f, 0.05f, 1.05f),
+                              point(7.05f, 0.05f, 1.05f, cls::kBuilding)};
+  LocalMap map = makeMap();
+  EXPECT_EQ(map.update(scan, Pose::Identity(), {0, 0}).points_inserted, 2u);
+  EXPECT_EQ(map.find(packVoxelKey({50, 0, 10})), nullptr);
+  EXPECT_NE(map.find(packVoxelKey({60, 0, 10})), nullptr);
+  LocalMapConfig paper;
+  paper.remove_unobserved = true;
+  LocalMap paper_map = makeMap(paper);
+  EXPECT_EQ(paper_map.update(scan, Pose::Identity(), {0, 0}).points_inserted, 1u);
+  // A scan without any class (no camera saw anything) is geometry-only even then.
+  EXPECT_EQ(paper_map.update(groundAndWall(false), Pose::Identity(), {0, 0}).points_inserted,
+            20u * 18u);
+  LocalMapConfig keep_unknown;
+  keep_unknown.remove_unknown_class = false;
+  EXPECT_EQ(makeMap(keep_unknown).update(scan, Pose::Identity(), {0, 0}).points_inserted, 3u);
+}
+
+// Outside the picture the road has no class to be removed by: its ground goes geometrically,
+// while labelled points are filtered by their class alone.
+TEST(LocalMap, UnobservedGroundIsRemovedGeometrically) {
+  LocalMap map = makeMap();
+  const LocalMapUpdate u = map.update(groundAndWall(false), Pose::Identity(), {0, 0});
+  EXPECT_EQ(u.points_unobserved, 3600u + 400u);
+  // The ground and the wall's lowest 25 cm (the ground's tolerance) go; the rest of the wall stays.
+  EXPECT_EQ(u.points_inserted, 20u * 18u);
+  for (const auto& [key, v] : map.voxels()) EXPECT_GT(v.centroid.z(), 0.25f) << key;
+  LocalMap labelled = makeMap();
+  const LocalMapUpdate l = labelled.update(groundAndWall(true), Pose::Identity(), {0, 0});
+  EXPECT_EQ(l.points_unobserved, 0u);
+  EXPECT_EQ(l.points_inserted, 400u);  // the road by its class, the whole wall kept
+}
+
+// The dynamic share of a voxel is taken over the points that have a class: a car the camera saw
+// in one frame and the LiDAR alone in three is still a car.
+TEST(LocalMap, DynamicShareCountsOnlyPointsWithAClass) {
+  EnrichedCloud scan = {road(5.05f)};
+  for (int k = 0; k < 3; ++k) scan.push_back(unobserved(5.05f, 0.05f, 1.05f));
+  scan.push_back(point(5.05f, 0.05f, 1.05f, cls::kCar));
+  LocalMap map = makeMap();
+  EXPECT_TRUE(map.update(scan, Pose::Identity(), {0, 0}).newly_active.empty());
+  EXPECT_EQ(map.find(packVoxelKey({50, 0, 10}))->n_classified, 1u);
 }

@@ -5,6 +5,7 @@
 // build has no libtorch.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -22,6 +23,7 @@
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/io/run_output.h"
 #include "semsegmap/pipeline/input_modalities.h"
+#include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/slam.h"
 
@@ -265,6 +267,29 @@ TEST(Modes, LocalizationRefusesAMapBuiltWithOtherSettingsUnlessAllowed) {
   EXPECT_NO_THROW(runLocalization(*query, other, map, oracle));
 }
 
+// Before unobserved points were told apart from class unknown, remove_unknown_class dropped both:
+// an old map that lacks remove_unobserved is read as built with it equal to remove_unknown_class.
+TEST(Modes, AMapOfAnOlderBuildReadsItsUnobservedRuleFromRemoveUnknownClass) {
+  PipelineConfig config = semsegmapConfig();
+  MapParameters old_map = mapParametersOf(config);
+  const auto key = [](const std::string& k) {
+    return [k](const std::pair<std::string, std::string>& kv) { return kv.first == k; };
+  };
+  old_map.erase(std::remove_if(old_map.begin(), old_map.end(), key("local_map.remove_unobserved")),
+                old_map.end());
+  config.local_map.remove_unobserved = config.local_map.remove_unknown_class;
+  EXPECT_EQ(upgradeMapParameters(old_map), mapParametersOf(config));
+  TargetMap map;
+  map.parameters = old_map;
+  EXPECT_NO_THROW(checkMapParameters("old.map", map, config, MapSettingsCheck::kRefuse));
+  config.local_map.remove_unobserved = !config.local_map.remove_unknown_class;
+  EXPECT_THROW(checkMapParameters("old.map", map, config, MapSettingsCheck::kRefuse),
+               std::runtime_error);
+  // A map that records the flag keeps what it recorded.
+  map.parameters = mapParametersOf(config);
+  EXPECT_EQ(upgradeMapParameters(map.parameters), map.parameters);
+}
+
 TEST(Modes, LocalizationRefusesAMapOfAnotherModel) {
   SEMSEGMAP_SKIP_WITHOUT_SIM();
   const auto oracle = std::make_shared<OracleDescriber>();
@@ -329,7 +354,7 @@ TEST(Modes, RefinementRefusesAMapWithoutPoints) {
 // trained on simulated data only; in a build without libtorch, the eigenvalue features.
 TEST(Modes, RealDataConfigMapsAndLocalizesTheKittiSample) {
   PipelineConfig config =
-      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap-kitti.yaml");
+      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/lidar-camera.yaml");
   if (!SEMSEGMAP_WITH_TORCH) config.descriptor = DescriptorConfig{"eigen", "", 64, ""};
   EXPECT_EQ(config.localization.localizer.verification.min_inliers, 7);
   const std::string spec = std::string("kitti-raw:") + SEMSEGMAP_SHARED_DATA +

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/pipeline/pipeline.h"
 #include "semsegmap/sim/simulator.h"
@@ -71,4 +72,50 @@ TEST(Pipeline, DataWithoutLabelsFallsBackToGeometricGroundRemoval) {
   double purity = 0.0;
   for (const auto& s : segments) purity += s.last().gt_purity;
   EXPECT_GT(purity / segments.size(), 0.7);
+}
+
+// One front camera on a 360-degree LiDAR: unobserved points are kept with their geometry (the
+// segments grow around the whole robot, pure, without road), or, with the paper's
+// remove_unobserved, dropped with a one-line warning that says what to change.
+TEST(Pipeline, AFrontCameraRigKeepsUnobservedPointsAsGeometry) {
+  sim::SimConfig c;
+  c.world = sim::worldPreset("tiny", 1);
+  c.run = sim::Run::S2;
+  c.max_frames = 12;
+  c.rig.lidar = lidarPreset("hdl64");
+  c.camera_names = {"front"};
+  sim::Simulator simulator(c);
+  PipelineConfig keep =
+      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap.yaml");
+  keep.local_map.remove_unobserved = false;
+  PipelineConfig drop = keep;
+  drop.local_map.remove_unobserved = true;
+  std::vector<std::string> messages;
+  setMessageSink([&](const std::string& line) { messages.push_back(line); });
+  Pipeline kept(keep, simulator.info(), PoseSource::kGroundTruth);
+  Pipeline dropped(drop, simulator.info(), PoseSource::kGroundTruth);
+  size_t inserted_kept = 0, inserted_dropped = 0, unobserved = 0, points = 0;
+  for (size_t i = 0; i < simulator.size(); ++i) {
+    const Frame f = simulator.frame(i);
+    const FrameResult a = kept.process(f), b = dropped.process(f);
+    inserted_kept += a.map_update.points_inserted;
+    inserted_dropped += b.map_update.points_inserted;
+    unobserved += a.map_update.points_unobserved;
+    points += a.points;
+  }
+  std::vector<Segment> segments = kept.finish();
+  dropped.finish();
+  setMessageSink({});
+  EXPECT_GT(unobserved, points / 2);
+  EXPECT_GT(inserted_kept, 2 * inserted_dropped);
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_NE(messages[0].find("local_map.remove_unobserved drops the rest"), std::string::npos)
+      << messages[0];
+  ASSERT_GT(segments.size(), 5u);
+  double purity = 0.0;
+  for (const auto& s : segments) {
+    purity += s.last().gt_purity;
+    EXPECT_NE(s.last().majority_class, cls::kRoad);
+  }
+  EXPECT_GT(purity / segments.size(), 0.8);
 }

@@ -17,6 +17,8 @@
 
 #include "error_text.h"
 #include "mini_kitti.h"
+#include "semsegmap/core/diagnostics.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/kitti_calib.h"
 #include "semsegmap/io/kitti_raw_reader.h"
@@ -518,6 +520,44 @@ TEST(SemanticKitti, LabelsAndPosesAreOptional) {
   EXPECT_TRUE(f.point_labels.empty());
   EXPECT_FALSE(f.T_world_base.has_value());
   EXPECT_NEAR(f.timestamp_s, 0.2, 1e-12);
+}
+
+// A sequence's poses are its odometry too: said in one line and marked, until --odometry FILE
+// replaces it. That file's KITTI lines go by the scans' frame numbers, as poses.txt's do.
+TEST(SemanticKitti, GroundTruthAsOdometryIsSaidAndAPoseFileGoesByFrameNumber) {
+  TempDir tmp;
+  const SemanticKittiFixture fx = writeSemanticKitti(tmp.path() / "08");
+  for (const char* file : {"velodyne/000001.bin", "labels/000001.label"})
+    fs::remove(fx.dir / file);  // sparse: frames 0 and 2
+  fs::remove(fx.dir / "times.txt");
+  std::vector<std::string> lines;
+  setMessageSink([&](const std::string& line) { lines.push_back(line); });
+  const auto own = openDataset("semantickitti:" + fx.dir.string());
+  EXPECT_TRUE(own->info().odometry_is_ground_truth);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("semantickitti:08: its ground-truth poses serve as its odometry too"),
+            std::string::npos)
+      << lines[0];
+  lines.clear();
+  writeText(tmp.path() / "odom" / "odom.txt",
+            "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 10 0 1 0 0 0 0 1 0\n1 0 0 20 0 1 0 0 0 0 1 0\n");
+  DatasetOptions options;
+  options.odometry = tmp.path() / "odom" / "odom.txt";  // no calib.txt beside it: base poses
+  const auto posed = openDataset("semantickitti:" + fx.dir.string(), options);
+  setMessageSink({});
+  EXPECT_FALSE(posed->info().odometry_is_ground_truth);
+  ASSERT_EQ(posed->size(), 2u);
+  EXPECT_EQ(posed->frameNumber(1), 2u);
+  EXPECT_NEAR(posed->frame(1).T_odom_base.translation().x(), 20.0, 1e-12);  // line 2, not 1
+  ASSERT_EQ(lines.size(), 1u) << ::testing::PrintToString(lines);
+  EXPECT_NE(lines[0].find("KITTI poses matched by frame number"), std::string::npos) << lines[0];
+  // Without times.txt its times are made up from the frame numbers: no TUM poses to them.
+  writeText(tmp.path() / "odom" / "odom.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n");
+  options.odometry = tmp.path() / "odom" / "odom.tum";
+  EXPECT_NE(errorOf([&] {
+              openDataset("semantickitti:" + fx.dir.string(), options);
+            }).find("odom.tum: TUM poses are matched to scans by time"),
+            std::string::npos);
 }
 
 TEST(SemanticKitti, LabelCountMismatchNamesBothFiles) {

@@ -83,7 +83,7 @@ class CountingSource : public FrameSource {
 TEST(RevisitExperiment, RefusesBadRangesAndMissingGroundTruthBeforeReadingAFrame) {
   TempDir tmp;
   RevisitExperimentConfig cfg;
-  cfg.configs = {loadNamedConfig(kSource + "/config/semsegmap-kitti.yaml")};
+  cfg.configs = {loadNamedConfig(kSource + "/config/lidar-camera.yaml")};
   const auto refusal = [&](bool gt, const std::string& map, const std::string& query) {
     CountingSource source(gt);
     cfg.map_frames = parseFrameRanges(map, "map");
@@ -215,7 +215,7 @@ TEST(RevisitExperiment, RealKittiRevisitsAreFoundAndNoneIsFarOff) {
   auto source = openDataset("semantickitti:" + kKittiSparse.string());
   ASSERT_EQ(source->size(), 36u);
   RevisitExperimentConfig cfg = kittiRevisit();
-  NamedConfig shipped = loadNamedConfig(kSource + "/config/semsegmap-kitti.yaml");
+  NamedConfig shipped = loadNamedConfig(kSource + "/config/lidar-camera.yaml");
   ASSERT_GT(shipped.config.localization.latest_scan_fallback_m, 0.0);
   cfg.configs = {shipped, variant(shipped, "local-map-only", [](PipelineConfig& c) {
                    c.localization.latest_scan_fallback_m = 0.0;
@@ -270,7 +270,7 @@ TEST(RevisitExperiment, RealKittiWakeUpLocalizesFromOneScanWithEarlierObservatio
   auto source = openDataset("semantickitti:" + kKittiSparse.string());
   RevisitExperimentConfig cfg = kittiRevisit();
   parseWakeUp("1", "wake-up", cfg);
-  NamedConfig shipped = loadNamedConfig(kSource + "/config/semsegmap-kitti.yaml");
+  NamedConfig shipped = loadNamedConfig(kSource + "/config/lidar-camera.yaml");
   ASSERT_GT(shipped.config.target_map.earlier_observations_apart_m, 0.0);
   cfg.configs = {shipped, variant(shipped, "final-only", [](PipelineConfig& c) {
                    c.target_map.earlier_observations_apart_m = 0.0;

@@ -24,6 +24,7 @@ EnrichedPoint point(const Eigen::Vector3f& p, ClassId c = cls::kBuilding, float 
   q.h = hue;
   q.s = q.v = 0.5f;
   q.has_color = true;
+  q.has_class = true;
   q.class_id = c;
   return q;
 }
@@ -75,6 +76,7 @@ TEST(SemanticDistance, IsTheFormulaOfThePaper) {
   a.position = {0, 0, 0};
   b.position = {0.1f, 0.2f, 0.0f};
   a.has_color = b.has_color = true;
+  a.has_class = b.has_class = true;
   a.class_id = b.class_id = cls::kBuilding;
   a.hue = 0.95f;
   b.hue = 0.03f;  // cyclic difference 0.08 <= t_h: no hue penalty
@@ -83,6 +85,10 @@ TEST(SemanticDistance, IsTheFormulaOfThePaper) {
   EXPECT_NEAR(d.squared(a, b), 0.05f + 0.05f * 0.05f, 1e-6f);
   b.class_id = cls::kVegetation;
   EXPECT_NEAR(d.squared(a, b), 0.05f + 0.0025f + 0.0225f, 1e-6f);
+  // An unobserved voxel's class id means nothing: no penalty.
+  b.has_class = false;
+  EXPECT_NEAR(d.squared(a, b), 0.05f + 0.0025f, 1e-6f);
+  b.has_class = true;
   // Without colour or class evidence there is nothing to penalise.
   b.has_color = false;
   b.class_id = cls::kUnknown;

@@ -335,6 +335,35 @@ TEST(LabelSet, ErrorsNameTheFile) {
                          {"labels a dataset of 3 frames, this one has 2"}));
 }
 
+// `label --max-frames 1` labels frame 0 of two: the set says so, and serves a run that reads
+// frame 0 only; one that reads both is refused up front, naming the set's folder.
+TEST(LabelSet, ASetOfFewerFramesServesOnlyRunsThatReadNoMore) {
+  TempDir tmp;
+  const fs::path dir = tmp.path() / "labels";
+  fs::create_directories(dir);
+  writeLabelSet(dir, "semsegmap", cls::kPole);
+  fs::remove(labelSetImage(dir, 0, 1));
+  LabelSetInfo set;
+  set.frames = 1;
+  set.dataset_frames = 2;
+  set.cameras = 1;
+  writeLabelSetInfo(dir, set);
+  const LabelSetInfo read = readLabelSetInfo(dir);
+  EXPECT_EQ(read.frames, 1u);
+  EXPECT_EQ(read.dataset_frames, 2u);
+  auto source = withLabelSet(std::make_unique<MemorySource>(), dir, kClassMaps, 1);
+  EXPECT_EQ(source->frame(0).cameras[0].label, Image(16, 16, 1, cls::kPole));
+  EXPECT_TRUE(throwsWith(
+      [&] { withLabelSet(std::make_unique<MemorySource>(), dir, kClassMaps); },
+      {dir.string() + ": the label set labels frames 0 to 0 only, this run reads 2 frames",
+       "--max-frames 1"}));
+  set.dataset_frames = 5;  // made from another dataset, though it labels the frames asked for
+  writeLabelSetInfo(dir, set);
+  EXPECT_TRUE(
+      throwsWith([&] { withLabelSet(std::make_unique<MemorySource>(), dir, kClassMaps, 1); },
+                 {"labels a dataset of 5 frames, this one has 2"}));
+}
+
 TEST(SemanticSources, TheNetworkIsCheckedOnEveryCameraBeforeAnyFrame) {
   SemanticsConfig c = plainConfig();
   c.class_map = (fs::path(SEMSEGMAP_SOURCE_DIR) / "config/class_maps/cityscapes.yaml").string();
@@ -382,6 +411,29 @@ TEST(SemanticsConfig, ReadFromTheConfigRelativeToIt) {
   EXPECT_TRUE(throwsWith([&] { loadSemanticsConfig(file); }, {"semantics.std: must be positive"}));
   std::ofstream(file) << "semantics:\n  input_width: 64\n";
   EXPECT_TRUE(throwsWith([&] { loadPipelineConfig(file); }, {"input_width, input_height"}));
+}
+
+// A shipped config copied elsewhere (as a user starts their own) loses its ../models/: its
+// models are then found by name among the shipped ones, and a model of the user's own that is
+// missing keeps its path beside the config, for the model's loader to refuse by that name.
+TEST(PipelineConfigFile, ACopiedConfigStillFindsItsShippedModels) {
+  TempDir tmp;
+  const fs::path source = fs::path(SEMSEGMAP_SOURCE_DIR);
+  const fs::path copy = tmp.path() / "my-rig.yaml";
+  fs::copy_file(source / "config" / "lidar-camera.yaml", copy);
+  const PipelineConfig c = loadPipelineConfig(copy);
+  ASSERT_TRUE(fs::exists(c.descriptor.model)) << c.descriptor.model;
+  EXPECT_TRUE(
+      fs::equivalent(c.descriptor.model, source / "models" / "semsegmap-net-3worlds.model"));
+  EXPECT_TRUE(
+      fs::equivalent(c.descriptor.model_lidar_only, source / "models" / "semsegmap-net.model"));
+  // In place, the path beside the config is the one used.
+  const PipelineConfig shipped = loadPipelineConfig(source / "config" / "lidar-camera.yaml");
+  EXPECT_EQ(
+      shipped.descriptor.model,
+      (source / "config" / "../models/semsegmap-net-3worlds.model").lexically_normal().string());
+  std::ofstream(copy) << "descriptor:\n  kind: semsegmap-net\n  model: mine/net.model\n";
+  EXPECT_EQ(loadPipelineConfig(copy).descriptor.model, (tmp.path() / "mine/net.model").string());
 }
 
 }  // namespace

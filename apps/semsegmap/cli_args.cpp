@@ -30,16 +30,17 @@ bool parseNumber(const std::string& text, double* out) {
   return !text.empty() && used == text.size() && std::isfinite(*out);
 }
 
-// The literal words an option accepts ("point|voxel"), or none when any value goes: without a
-// '|', or when one of the items is itself a placeholder in capitals ("FILE|lidar": a file, or the
-// word lidar).
+// The literal words an option accepts ("point|voxel", "S0|S1"), or none when any value goes:
+// without a '|', or when one of the items is itself a placeholder, a word of capital letters
+// alone ("FILE|lidar": a file, or the word lidar).
 std::vector<std::string> choicesOf(const OptionSpec& option) {
   std::vector<std::string> out;
   if (option.placeholder.find('|') == std::string::npos) return out;
   std::stringstream s(option.placeholder);
   std::string item;
   while (std::getline(s, item, '|')) {
-    if (std::any_of(item.begin(), item.end(), [](char c) { return c >= 'A' && c <= 'Z'; }))
+    if (!item.empty() &&
+        std::all_of(item.begin(), item.end(), [](char c) { return c >= 'A' && c <= 'Z'; }))
       return {};
     out.push_back(item);
   }
@@ -149,9 +150,9 @@ const char* const kDatasetNotes =
     "    [,base_frame=F][,odom_frame=F][,tolerance=S] (ROS 1 and ROS 2 bags),\n"
     "  "
     "sim:world=N,run=S0..S3[,condition=sunrise][,traffic=M][,frames=K][,preset=small][,sweep=1]\n"
-    "    [,label_noise=0..3][,lidar=paper|hdl64|vlp32|os128|solid][,cameras=0][,classes=0]\n"
-    "    [,laps=N] (the built-in simulator; cameras=0,classes=0: a LiDAR without a camera;\n"
-    "    laps: S2 or S3 driven N times without stopping)\n";
+    "    [,label_noise=0..3][,lidar=paper|hdl64|vlp32|os128|solid][,cameras=0|front[+left...]]\n"
+    "    [,classes=0][,laps=N] (the built-in simulator; cameras=0,classes=0: a LiDAR without a\n"
+    "    camera; cameras=front: its front camera alone; laps: S2 or S3 driven N times)\n";
 #else
     "datasets (SPEC): DIR (the project's format), kitti-raw:PATH, semantickitti:PATH, nclt:PATH,\n"
     "  folder:DIR[,rig=FILE][,times=FILE][,tolerance=S] (scans and pictures, docs/rig-format.md),\n"

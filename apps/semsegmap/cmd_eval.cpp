@@ -94,6 +94,7 @@ LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   if (a.command().name != "eval localization") return c;  // the paper's setting otherwise
   c.label_noise = static_cast<int>(a.getCount("label-noise"));
   if (c.label_noise > 3) throw UsageError("--label-noise is 0 (perfect labels) to 3");
+  if (a.has("rig")) c.rig = a.get("rig");
   const std::string odometry = a.get("odometry");
   if (odometry != "simulated" && odometry != "lidar")
     throw UsageError("--odometry expects simulated or lidar, got '" + odometry + "'");
@@ -186,6 +187,8 @@ const OptionSpec kQueryRuns{"query-runs", Value::kText, "LIST", "S2,S3",
                             "the runs localized against the map"};
 const OptionSpec kLabelNoise{"label-noise", Value::kCount, "L", "0",
                              "camera labels as a segmentation network's, 0 (perfect) to 3"};
+const OptionSpec kRig{"rig", Value::kText, "KEYS", "",
+                      "simulator keys for every run's rig, e.g. lidar=hdl64,cameras=front"};
 const OptionSpec kQueryOdometry{
     "odometry", Value::kText, "simulated|lidar", "simulated",
     "the query runs' odometry: the simulator's drifting one, or LiDAR odometry on their scans"};
@@ -210,7 +213,7 @@ const std::vector<const CommandSpec*>& simulatedEvalCommands() {
       "eval localization",
       "maps one run, localizes the others with each config -> localization.json",
       {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kMapRun, kQueryRuns, kLabelNoise,
-       kQueryOdometry},
+       kQueryOdometry, kRig},
       "",
       runEvalLocalization};
   static const CommandSpec paper{

@@ -54,7 +54,7 @@ const CommandSpec& evalRevisitsCommand() {
            {"query-frames", Value::kText, "E:F[,G:H]", "",
             "frames localized against it, on the dataset's odometry", kRequired},
            {"configs", Value::kText, "A.yaml,B.yaml",
-            "config/semsegmap-kitti.yaml,config/segmap-kitti.yaml",
+            "config/lidar-camera.yaml,config/segmap-baseline.yaml",
             "the configurations compared (default: the shipped real-data ones)"},
            {"place-radius", Value::kNumber, "M", "10",
             "a query frame this close to a mapped frame is at a revisit"},

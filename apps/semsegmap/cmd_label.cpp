@@ -50,6 +50,9 @@ int runLabel(const CliArgs& a) {
     throw std::runtime_error("dataset '" + a.get("dataset") + "' has no cameras to label");
   for (size_t k = 0; k < info.rig.cameras.size(); ++k)
     std::filesystem::create_directories(labelSetImage(out, k, 0).parent_path());
+  // labels.yaml says the set is whole: an earlier one goes first and the new one comes last, so
+  // that a run stopped half way (an error, Ctrl-C) leaves a set that --labels refuses.
+  std::filesystem::remove(out / "labels.yaml");
 
   const size_t n = a.frameLimit(source->size());
   size_t written = 0;
@@ -60,7 +63,8 @@ int runLabel(const CliArgs& a) {
     progress.update(i + 1);
   }
   LabelSetInfo set;
-  set.frames = source->size();
+  set.frames = n;  // the frames labelled, not the dataset's
+  set.dataset_frames = source->size();
   set.cameras = info.rig.cameras.size();
   set.dataset = a.get("dataset");
   set.model = model;

@@ -71,12 +71,13 @@ int runLocalize(const CliArgs& a) {
                 run.stats.frames, s.localizations, run.stats.fps());
   else if (s.localizations == 0)  // no mean of nothing: "0.00 m" would read as perfect
     std::printf("frames %zu  localizations 0  %.1f Hz\n", run.stats.frames, run.stats.fps());
-  else
+  else  // errors against the poses the local map was built on say little: marked
     std::printf(
         "frames %zu  localizations %zu  <1 m %zu  <5 m %zu  mean error %.2f m %.2f deg  "
-        "%.1f Hz\n",
+        "%.1f Hz%s\n",
         run.stats.frames, s.localizations, s.below_1m, s.below_5m, s.mean_translation_error_m,
-        s.mean_rotation_error_deg, run.stats.fps());
+        s.mean_rotation_error_deg, run.stats.fps(),
+        run.odometry_is_ground_truth ? "  [errors against the ground truth used as odometry]" : "");
   std::cout << "wrote " << (out / "localizations.csv").string()
             << ", matches.csv, trajectory.csv, summary.json, localization.png\n";
   return 0;

@@ -44,9 +44,11 @@ int runSlamCommand(const CliArgs& a) {
   const std::optional<SlamErrors> errors = slamErrors(run);
   const bool has_gt = errors.has_value();
   if (errors)
-    std::printf("ATE (RMSE) odometry %.2f m -> with loop closure %.2f m  (aligned: %.2f -> %.2f)\n",
-                errors->odometry.rmse_m, errors->slam.rmse_m, errors->odometry_aligned.rmse_m,
-                errors->slam_aligned.rmse_m);
+    std::printf(
+        "ATE (RMSE) odometry %.2f m -> with loop closure %.2f m  (aligned: %.2f -> %.2f)%s\n",
+        errors->odometry.rmse_m, errors->slam.rmse_m, errors->odometry_aligned.rmse_m,
+        errors->slam_aligned.rmse_m,
+        run.odometry_is_ground_truth ? "  [odometry is the ground truth]" : "");
 
   std::vector<viz::TrajectoryCurve> curves;
   if (has_gt) curves.push_back({"ground truth", 200, 200, 200, run.trajectory_gt});

@@ -123,6 +123,8 @@ class DatasetInfo:
     classes: ClassTable
     has_ground_truth_poses: bool
     has_odometry: bool
+    odometry_is_ground_truth: bool
+    has_frame_times: bool
     has_point_labels: bool
     point_labels_have_classes: bool
     first_transient_instance: int
@@ -162,6 +164,7 @@ class LocalMapConfig:
     dynamic_vote_share: float
     remove_ground_classes: bool
     remove_unknown_class: bool
+    remove_unobserved: bool
     geometric_ground_removal: bool
     ground: GroundRemovalConfig
     def __init__(self, **fields: object) -> None: ...
@@ -547,6 +550,8 @@ class LocalizationRun:
     def trajectory_odom(self) -> _F64: ...
     @property
     def distance_m(self) -> float: ...
+    @property
+    def odometry_is_ground_truth(self) -> bool: ...
     @property
     def stats(self) -> RunStats: ...
     def summary(self) -> LocalizationSummary: ...

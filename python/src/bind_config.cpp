@@ -31,6 +31,7 @@ void bindFrontEndConfigs(py::module_& m) {
       .field("dynamic_vote_share", &LocalMapConfig::dynamic_vote_share)
       .field("remove_ground_classes", &LocalMapConfig::remove_ground_classes)
       .field("remove_unknown_class", &LocalMapConfig::remove_unknown_class)
+      .field("remove_unobserved", &LocalMapConfig::remove_unobserved)
       .field("geometric_ground_removal", &LocalMapConfig::geometric_ground_removal)
       .field("ground", &LocalMapConfig::ground);
 

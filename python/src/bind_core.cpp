@@ -263,6 +263,8 @@ void bindDatasetInfo(py::module_& m) {
       .field("classes", &DatasetInfo::classes)
       .field("has_ground_truth_poses", &DatasetInfo::has_ground_truth_poses)
       .field("has_odometry", &DatasetInfo::has_odometry)
+      .field("odometry_is_ground_truth", &DatasetInfo::odometry_is_ground_truth)
+      .field("has_frame_times", &DatasetInfo::has_frame_times)
       .field("has_point_labels", &DatasetInfo::has_point_labels)
       .field("point_labels_have_classes", &DatasetInfo::point_labels_have_classes)
       .field("first_transient_instance", &DatasetInfo::first_transient_instance);
@@ -271,7 +273,8 @@ void bindDatasetInfo(py::module_& m) {
 }  // namespace
 
 void bindCore(py::module_& m) {
-  PYBIND11_NUMPY_DTYPE(EnrichedPoint, x, y, z, h, s, v, class_id, has_color, instance_id);
+  PYBIND11_NUMPY_DTYPE(EnrichedPoint, x, y, z, h, s, v, class_id, has_color, has_class,
+                       instance_id);
   m.attr("ENRICHED_POINT_DTYPE") = py::dtype::of<EnrichedPoint>();
   bindFrame(m);
   bindRig(m);

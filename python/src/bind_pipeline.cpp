@@ -307,6 +307,7 @@ void bindLocalizationResults(py::module_& m) {
       .def_property_readonly("trajectory_odom",
                              [](const LocalizationRun& r) { return posesArray(r.trajectory_odom); })
       .def_readonly("distance_m", &LocalizationRun::distance_m)
+      .def_readonly("odometry_is_ground_truth", &LocalizationRun::odometry_is_ground_truth)
       .def_readonly("stats", &LocalizationRun::stats)
       .def("summary", [](const LocalizationRun& r) { return summarize(r.localizations); });
   m.def("summarize", &summarize, py::arg("records"));

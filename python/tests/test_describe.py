@@ -16,7 +16,7 @@ def enriched(xyz, hue=0.3, cls=4):
     p = np.zeros(len(xyz), ssm.ENRICHED_POINT_DTYPE)
     p["x"], p["y"], p["z"] = xyz.T
     p["h"], p["s"], p["v"] = hue, 0.5, 0.5
-    p["class_id"], p["has_color"] = cls, True
+    p["class_id"], p["has_color"], p["has_class"] = cls, True, True
     return p
 
 

@@ -58,7 +58,7 @@ def test_segment_overlap_example_refuses_a_dataset_without_ground_truth(tmp_dir)
     done = subprocess.run(
         [sys.executable, source_file("examples/segment_overlap.py"), "--map", "none.map",
          "--dataset", "folder:" + scans, "--frames", "0", "--config",
-         source_file("config/semsegmap-kitti.yaml")],
+         source_file("config/lidar-camera.yaml")],
         capture_output=True, text=True, cwd=tmp_dir)
     assert done.returncode == 1, done.stderr
     assert done.stderr.strip().splitlines()[-1] == (

@@ -128,5 +128,7 @@ def test_class_table_and_dataset_info():
 
 def test_the_enriched_point_dtype_matches_the_library():
     dt = ssm.ENRICHED_POINT_DTYPE
-    assert dt.names == ("x", "y", "z", "h", "s", "v", "class_id", "has_color", "instance_id")
+    assert dt.names == (
+        "x", "y", "z", "h", "s", "v", "class_id", "has_color", "has_class", "instance_id"
+    )
     assert dt["class_id"] == np.uint16 and dt["has_color"] == np.bool_

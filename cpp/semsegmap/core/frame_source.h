@@ -2,6 +2,7 @@
 // only sees this interface.
 #pragma once
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -20,6 +21,13 @@ struct DatasetInfo {
   // simulator's drifting odometry). Without it T_odom_base is meaningless, and running on it
   // is refused instead of reading identity poses.
   bool has_odometry = false;
+  // Whether that odometry is the ground truth itself (a SemanticKITTI sequence's poses, KITTI
+  // raw's oxts, NCLT's ground truth): errors measured against the ground truth then say how
+  // well the run does with perfect odometry, and are marked so.
+  bool odometry_is_ground_truth = false;
+  // Whether the frame times come from the data (file names, a times file, the recording);
+  // false: made up from the rate, so that poses cannot be matched to frames by time.
+  bool has_frame_times = true;
   bool has_point_labels = false;
   // Whether those labels carry classes; false: instance ids only (the simulator's `classes=0`,
   // ground truth for training a descriptor for a LiDAR without a camera), so the scans carry
@@ -39,6 +47,9 @@ class FrameSource {
   virtual Frame frame(size_t index) = 0;
   // The time of a frame; sources that know it without reading the frame say so faster.
   virtual double frameTime(size_t index) { return frame(index).timestamp_s; }
+  // The frame number in the name of the frame's scan (KITTI's 000042.bin is 42), to which a
+  // KITTI pose file's line refers; nothing when the source does not name its scans by number.
+  virtual std::optional<size_t> frameNumber(size_t /*index*/) { return std::nullopt; }
 };
 
 // What every FrameSource throws for an index past its end.

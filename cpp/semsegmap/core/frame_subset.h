@@ -22,6 +22,9 @@ class FrameSubset : public FrameSource {
     return f;
   }
   double frameTime(size_t index) override { return source_.frameTime(frames_.at(index)); }
+  std::optional<size_t> frameNumber(size_t index) override {
+    return source_.frameNumber(frames_.at(index));
+  }
   size_t datasetFrame(size_t index) const { return frames_.at(index); }
 
  private:

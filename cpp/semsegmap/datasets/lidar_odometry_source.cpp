@@ -13,11 +13,14 @@ class LidarOdometrySource : public FrameSource {
   LidarOdometrySource(std::unique_ptr<FrameSource> source, const OdometryConfig& config)
       : source_(std::move(source)), odometry_(config), info_(source_->info()) {
     info_.has_odometry = true;
+    info_.odometry_is_ground_truth = false;
     T_base_lidar_ = info_.rig.T_base_lidar;
   }
 
   const DatasetInfo& info() const override { return info_; }
   size_t size() const override { return source_->size(); }
+  double frameTime(size_t index) override { return source_->frameTime(index); }
+  std::optional<size_t> frameNumber(size_t index) override { return source_->frameNumber(index); }
 
   Frame frame(size_t index) override {
     if (index >= size()) throwFrameOutOfRange(info_.name, index, size());

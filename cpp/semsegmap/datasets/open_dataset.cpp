@@ -47,6 +47,21 @@ LidarModel lidarPresetOf(const std::string& spec, const std::string& name) {
   }
 }
 
+// cameras=0 or 1 (none or all), or the cameras to keep by name joined by '+': cameras=front.
+void parseSimCameras(const std::string& spec, const std::string& value, sim::SimConfig& config) {
+  if (value == "0" || value == "1") {
+    config.render_cameras = value == "1";
+    return;
+  }
+  std::stringstream names(value);
+  for (std::string name; std::getline(names, name, '+');) {
+    if (name.empty())
+      throw std::invalid_argument("dataset '" + spec + "': cameras=" + value +
+                                  ": expected 0, 1 or camera names joined by '+'");
+    config.camera_names.push_back(name);
+  }
+}
+
 std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::string& args) {
   std::string preset = "full";
   uint64_t world_seed = 1;
@@ -72,7 +87,7 @@ std::unique_ptr<FrameSource> openSimulator(const std::string& spec, const std::s
     else if (key == "preset")
       preset = value;
     else if (key == "cameras")
-      config.render_cameras = parseUnsigned(spec, key, value) != 0;
+      parseSimCameras(spec, value, config);
     else if (key == "lidar")
       config.rig.lidar = lidarPresetOf(spec, value);
     else if (key == "classes")
@@ -177,8 +192,13 @@ std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetO
   poses.kitti_calib = options.kitti_calib;
   source = withPoseFiles(std::move(source), poses);
   if (lidar_odometry) source = withLidarOdometry(std::move(source), options.lidar_odometry);
+  if (source->info().odometry_is_ground_truth)
+    note(source->info().name +
+         ": its ground-truth poses serve as its odometry too (--odometry FILE or --odometry "
+         "lidar for odometry of its own): errors measured against them are marked so");
   if (!options.labels.empty())
-    source = withLabelSet(std::move(source), options.labels, options.class_maps_dir);
+    source = withLabelSet(std::move(source), options.labels, options.class_maps_dir,
+                          options.frames_to_check);
   if (options.semantics.model.empty()) return source;
   auto network = loadSegmentationNetwork(options.semantics, source->info(), options.class_maps_dir);
   return withSegmentationNetwork(std::move(source), std::move(network));

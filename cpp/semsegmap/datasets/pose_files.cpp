@@ -1,5 +1,6 @@
 #include "semsegmap/datasets/pose_files.h"
 
+#include <algorithm>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -35,23 +36,75 @@ void applyKittiCalib(const fs::path& poses_path, const fs::path& explicit_calib,
   for (size_t i = 0; i < poses.size(); ++i) poses[i].T = T_base_lidar * lidar[i] * T_lidar_base;
 }
 
-// Per frame of the source, its pose from the file, or nothing.
-std::vector<std::optional<Pose>> posesPerFrame(FrameSource& source, const fs::path& path,
-                                               const PoseFileOptions& options) {
-  PoseFile file = readPoseFile(path);
-  std::vector<std::optional<Pose>> per_frame(source.size());
-  if (!file.timestamped) {
-    applyKittiCalib(path, options.kitti_calib, source.info().rig.T_base_lidar, file.poses);
-    if (file.poses.size() < source.size())
-      throw std::runtime_error(path.string() + ": " + std::to_string(file.poses.size()) +
-                               " KITTI poses for " + std::to_string(source.size()) +
-                               " scans (line i is the pose of scan i)");
-    for (size_t i = 0; i < source.size(); ++i) per_frame[i] = file.poses[i].T;
+using PerFrame = std::vector<std::optional<Pose>>;
+
+// The frame numbers of the source's scans; empty unless every scan is named by one.
+std::vector<size_t> frameNumbersOf(FrameSource& source) {
+  std::vector<size_t> numbers;
+  for (size_t i = 0; i < source.size(); ++i) {
+    const std::optional<size_t> number = source.frameNumber(i);
+    if (!number) return {};
+    numbers.push_back(*number);
+  }
+  return numbers;
+}
+
+// KITTI poses have no times: line N is the pose of the scan numbered N. Scans named otherwise
+// take the lines in order only when there is one line per scan; any other count is a guess.
+PerFrame kittiPosesPerFrame(FrameSource& source, const fs::path& path,
+                            const std::vector<StampedPose>& poses) {
+  const std::vector<size_t> numbers = frameNumbersOf(source);
+  PerFrame per_frame(source.size());
+  if (!numbers.empty()) {
+    const size_t last = *std::max_element(numbers.begin(), numbers.end());
+    if (last >= poses.size())
+      throw std::runtime_error(path.string() + ": " + std::to_string(poses.size()) +
+                               " KITTI poses, but the scans go up to frame " +
+                               std::to_string(last) + " (line N is the pose of the scan named N)");
+    for (size_t i = 0; i < numbers.size(); ++i) per_frame[i] = poses[numbers[i]].T;
+    note(path.string() + ": KITTI poses matched by frame number: line N is the pose of the scan " +
+         "named N (" + std::to_string(numbers.size()) + " scans, frames " +
+         std::to_string(numbers.front()) + " to " + std::to_string(last) + ")");
     return per_frame;
   }
-  for (size_t i = 0; i < source.size(); ++i)
-    per_frame[i] = poseAt(file.poses, source.frameTime(i), options.max_gap_s);
+  if (poses.size() != source.size())
+    throw std::runtime_error(path.string() + ": " + std::to_string(poses.size()) +
+                             " KITTI poses for " + std::to_string(source.size()) +
+                             " scans whose names are no frame numbers: which line is which "
+                             "scan's would be a guess (name the scans by frame number, or give "
+                             "TUM poses)");
+  for (size_t i = 0; i < poses.size(); ++i) per_frame[i] = poses[i].T;
+  note(path.string() + ": KITTI poses taken in scan order, one line per scan (the " +
+       std::to_string(poses.size()) + " scans' names are no frame numbers)");
   return per_frame;
+}
+
+// TUM poses are interpolated to each scan's time, which must then come from the data.
+PerFrame tumPosesPerFrame(FrameSource& source, const fs::path& path,
+                          const std::vector<StampedPose>& poses, double max_gap_s) {
+  if (!source.info().has_frame_times)
+    throw std::runtime_error(path.string() + ": TUM poses are matched to scans by time, but the " +
+                             "scans of " + source.info().name +
+                             " have no times (names that are no times, no times file): give a "
+                             "times file, or KITTI poses");
+  PerFrame per_frame(source.size());
+  for (size_t i = 0; i < source.size(); ++i)
+    per_frame[i] = poseAt(poses, source.frameTime(i), max_gap_s);
+  note(path.string() + ": TUM poses matched by time, interpolated to each scan's time");
+  return per_frame;
+}
+
+// Per frame of the source, its pose from the file, or nothing.
+PerFrame posesPerFrame(FrameSource& source, const fs::path& path, const PoseFileOptions& options) {
+  PoseFile file = readPoseFile(path);
+  if (file.timestamped) return tumPosesPerFrame(source, path, file.poses, options.max_gap_s);
+  applyKittiCalib(path, options.kitti_calib, source.info().rig.T_base_lidar, file.poses);
+  return kittiPosesPerFrame(source, path, file.poses);
+}
+
+bool sameFile(const fs::path& a, const fs::path& b) {
+  std::error_code error;  // a missing or empty path is no file: not the same
+  return !a.empty() && !b.empty() && fs::equivalent(a, b, error) && !error;
 }
 
 class PosedSource : public FrameSource {
@@ -76,10 +129,15 @@ class PosedSource : public FrameSource {
            " scans lie outside the poses' time span or in a gap and are left out");
     info_.has_odometry |= !odom.empty();
     info_.has_ground_truth_poses |= !gt.empty();
+    // A replaced odometry or ground truth is no longer the other, unless both are one file.
+    info_.odometry_is_ground_truth = sameFile(options.odometry, options.ground_truth);
   }
   const DatasetInfo& info() const override { return info_; }
   size_t size() const override { return kept_.size(); }
   double frameTime(size_t index) override { return source_->frameTime(kept_.at(index).source); }
+  std::optional<size_t> frameNumber(size_t index) override {
+    return source_->frameNumber(kept_.at(index).source);
+  }
   Frame frame(size_t index) override {
     const Kept& k = kept_.at(index);
     Frame f = source_->frame(k.source);

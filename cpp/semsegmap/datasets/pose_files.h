@@ -1,5 +1,8 @@
 // Poses a dataset lacks, from files: `--odometry FILE` and `--ground-truth FILE` in TUM or KITTI
-// format. TUM poses are interpolated to each scan's time; KITTI poses pair with scans by index.
+// format. TUM poses are interpolated to each scan's time (which must come from the data:
+// DatasetInfo::has_frame_times). KITTI poses have no times: line N is the pose of the scan
+// named N (FrameSource::frameNumber); scans named otherwise take one line each in order, and only
+// when the counts are equal. Which rule was used is said in one note per file.
 // The files hold poses of the rig's base frame (the LiDAR when the rig does not mount it).
 #pragma once
 
@@ -21,8 +24,10 @@ struct PoseFileOptions {
 };
 
 // The source with its frames' T_odom_base / T_world_base replaced by the files' poses. Scans
-// outside a TUM file's time span, or in a gap, are left out (counted on stderr); none left, too
-// few KITTI poses, or an unreadable file: std::runtime_error naming the file.
+// outside a TUM file's time span, or in a gap, are left out (counted on stderr); none left, a
+// file that fits no rule above (too few KITTI poses for the largest frame number, a count that
+// differs from the scans' without frame numbers, TUM poses for scans without times) or an
+// unreadable file: std::runtime_error naming the file, before any frame is read.
 std::unique_ptr<FrameSource> withPoseFiles(std::unique_ptr<FrameSource> source,
                                            const PoseFileOptions& options);
 

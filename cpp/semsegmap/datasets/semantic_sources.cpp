@@ -18,6 +18,7 @@ class RelabelledSource : public FrameSource {
   const DatasetInfo& info() const override { return source_->info(); }
   size_t size() const override { return source_->size(); }
   double frameTime(size_t index) override { return source_->frameTime(index); }
+  std::optional<size_t> frameNumber(size_t index) override { return source_->frameNumber(index); }
 
  protected:
   std::unique_ptr<FrameSource> source_;
@@ -74,14 +75,33 @@ class NetworkSource : public RelabelledSource {
 
 }  // namespace
 
+namespace {
+
+// A set made from another dataset, or one that lacks frames the run reads, is refused before
+// the run: it would fail at its first unlabelled frame, or label frames with another's pictures.
+void checkLabelSetFrames(const LabelSetInfo& set, const std::filesystem::path& dir,
+                         size_t dataset_frames, size_t frames_needed) {
+  const std::string yaml = (dir / "labels.yaml").string();
+  const size_t made_from = set.dataset_frames > 0 ? set.dataset_frames : set.frames;
+  if (set.dataset_frames > 0 ? made_from != dataset_frames : made_from > dataset_frames)
+    throw std::runtime_error(yaml + ": labels a dataset of " + std::to_string(made_from) +
+                             " frames, this one has " + std::to_string(dataset_frames));
+  if (set.frames < frames_needed)
+    throw std::runtime_error(
+        dir.string() + ": the label set labels frames 0 to " + std::to_string(set.frames - 1) +
+        " only, this run reads " + std::to_string(frames_needed) +
+        " frames (label them all, or give --max-frames " + std::to_string(set.frames) + ")");
+}
+
+}  // namespace
+
 std::unique_ptr<FrameSource> withLabelSet(std::unique_ptr<FrameSource> source,
                                           const std::filesystem::path& dir,
-                                          const std::filesystem::path& class_maps_dir) {
+                                          const std::filesystem::path& class_maps_dir,
+                                          size_t max_frames) {
   const LabelSetInfo set = readLabelSetInfo(dir);
   const std::string yaml = (dir / "labels.yaml").string();
-  if (set.frames != source->size())
-    throw std::runtime_error(yaml + ": labels a dataset of " + std::to_string(set.frames) +
-                             " frames, this one has " + std::to_string(source->size()));
+  checkLabelSetFrames(set, dir, source->size(), framesToRead(*source, max_frames));
   const size_t cameras = source->info().rig.cameras.size();
   if (set.cameras != cameras)
     throw std::runtime_error(yaml + ": labels " + std::to_string(set.cameras) +

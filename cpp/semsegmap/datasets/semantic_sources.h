@@ -13,12 +13,14 @@
 namespace semsegmap {
 
 // Frames of `source` whose pictures take the label set's images (they replace the dataset's).
-// Checks up front that the set labels a dataset of this many frames and cameras and that its
-// class map reads; a picture without its label image, or of another size, is an error naming the
-// file. `class_maps_dir` holds the shipped class maps.
+// Checks up front that the set was made from a dataset of this many frames and cameras, that it
+// labels the frames the run reads (the first max_frames; 0: all) and that its class map reads; a
+// picture without its label image, or of another size, is an error naming the file.
+// `class_maps_dir` holds the shipped class maps.
 std::unique_ptr<FrameSource> withLabelSet(std::unique_ptr<FrameSource> source,
                                           const std::filesystem::path& dir,
-                                          const std::filesystem::path& class_maps_dir);
+                                          const std::filesystem::path& class_maps_dir,
+                                          size_t max_frames = 0);
 
 // The network of `config` (model, class map) loaded and checked against every camera of the rig
 // before any frame is read.

@@ -147,6 +147,9 @@ PointNetSample makePointNetSample(const EnrichedCloud& points, int num_points, i
       cell[a] = size > 0 ? cellOf(q[a], lo[a], size, 3) : 1;
     }
     const int flat = (cell[0] * 3 + cell[1]) * 3 + cell[2];
+    // An unobserved point is missing from its cell's histogram, not a vote for class unknown:
+    // a segment half in the picture gets the histogram of its seen half.
+    if (use_classes && !p.has_class) continue;
     const int cls = use_classes ? std::min<int>(p.class_id, num_classes - 1) : cls::kUnknown;
     counts[static_cast<size_t>(cls) * 27 + flat] += 1.0;
     totals[flat] += 1.0;

@@ -235,7 +235,12 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
   const size_t n_cams = frame.cameras.size();  // 0 when the frame has no images at all
   bool camera_semantics = false;
   for (const auto& cf : frame.cameras) camera_semantics |= !cf.label.empty();
-  const bool point_semantics = !camera_semantics && !frame.point_labels.empty();
+  // Point labels give classes only when some point has one: the simulator's point labels may
+  // carry ground-truth instances alone, and those points are unobserved, not of class unknown.
+  const bool point_semantics =
+      !camera_semantics &&
+      std::any_of(frame.point_labels.begin(), frame.point_labels.end(),
+                  [](const PointLabel& l) { return l.class_id != cls::kUnknown; });
 
   std::vector<CameraView>& views = scratchViews();
   if (views.size() < n_cams) views.resize(n_cams);
@@ -254,7 +259,10 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
     ep.z = lp.z;
     if (!frame.point_labels.empty()) {
       ep.instance_id = frame.point_labels[i].instance_id;
-      if (point_semantics) ep.class_id = frame.point_labels[i].class_id;
+      if (point_semantics) {
+        ep.class_id = frame.point_labels[i].class_id;
+        ep.has_class = true;
+      }
     }
     size_t pixel = 0;
     const int cam = bestCamera(frame, rig, views, static_cast<size_t>(i), config, pixel);
@@ -265,7 +273,10 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
       rgbToHsv(rgb[0], rgb[1], rgb[2], ep.h, ep.s, ep.v);
       ep.has_color = true;
     }
-    if (camera_semantics && !cf.label.empty()) ep.class_id = cf.label.data[pixel];
+    if (camera_semantics && !cf.label.empty()) {
+      ep.class_id = cf.label.data[pixel];
+      ep.has_class = true;
+    }
   }
   return cloud;
 }

@@ -20,10 +20,10 @@ struct EnrichmentConfig {
 };
 
 // Points come back in the LiDAR frame, in the frame's order. Points behind every camera or
-// outside every image get class unknown and no colour; a point seen by two cameras takes the one
-// whose image centre it is nearer to. Frames without camera labels but with per-point labels
-// (SemanticKITTI) take the class from the point labels. Ground-truth instances are copied from
-// the point labels when present.
+// outside every image are unobserved: no colour and no class (has_color and has_class false); a
+// point seen by two cameras takes the one whose image centre it is nearer to. Frames without
+// camera labels but with per-point classes (SemanticKITTI) take the class from the point labels.
+// Ground-truth instances are copied from the point labels when present.
 // Throws std::invalid_argument naming the camera when the frame's images do not match the rig
 // (count, width x height, channels).
 EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig, const EnrichmentConfig& config);

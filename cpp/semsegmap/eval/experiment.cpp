@@ -11,11 +11,12 @@ NamedConfig loadNamedConfig(const std::filesystem::path& path) {
 }
 
 std::string simulatedRunSpec(uint64_t world_seed, const std::string& run, const std::string& preset,
-                             size_t max_frames, int label_noise) {
+                             size_t max_frames, int label_noise, const std::string& rig) {
   std::string spec =
       "sim:world=" + std::to_string(world_seed) + ",run=" + run + ",preset=" + preset;
   if (max_frames > 0) spec += ",frames=" + std::to_string(max_frames);
   if (label_noise > 0) spec += ",label_noise=" + std::to_string(label_noise);
+  if (!rig.empty()) spec += "," + rig;
   return spec;
 }
 

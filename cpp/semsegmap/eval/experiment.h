@@ -19,9 +19,11 @@ struct NamedConfig {
 };
 NamedConfig loadNamedConfig(const std::filesystem::path& path);
 
-// "sim:world=N,run=R,preset=P[,frames=F][,label_noise=L]": the dataset spec of a simulated run.
+// "sim:world=N,run=R,preset=P[,frames=F][,label_noise=L][,RIG]": the dataset spec of a
+// simulated run; `rig` holds more simulator keys ("lidar=hdl64,cameras=front").
 std::string simulatedRunSpec(uint64_t world_seed, const std::string& run, const std::string& preset,
-                             size_t max_frames = 0, int label_noise = 0);
+                             size_t max_frames = 0, int label_noise = 0,
+                             const std::string& rig = "");
 
 // Called as work advances: a stage name (e.g. "map S0") and how far it is.
 using ExperimentProgress = std::function<void(const std::string& stage, size_t done, size_t total)>;

@@ -23,8 +23,8 @@ std::vector<BuiltMap> buildMaps(const LocalizationExperimentConfig& cfg,
                                 const std::vector<std::shared_ptr<Describer>>& describers,
                                 const std::filesystem::path& out,
                                 const ExperimentProgress& progress) {
-  auto source = openDataset(
-      simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset, cfg.max_frames, cfg.label_noise));
+  auto source = openDataset(simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset,
+                                             cfg.max_frames, cfg.label_noise, cfg.rig));
   auto sessions =
       mappingSessions(cfg.configs, source->info(), describers, cfg.picture_points_per_segment);
   forEachFrame(*source, "map " + cfg.map_run, progress, [&](const Frame& frame) {
@@ -91,9 +91,9 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
     options.odometry = "lidar";
     options.lidar_odometry = cfg.odometry;
   }
-  auto source = openDataset(
-      simulatedRunSpec(cfg.world_seed, run_name, cfg.preset, cfg.max_frames, cfg.label_noise),
-      options);
+  auto source = openDataset(simulatedRunSpec(cfg.world_seed, run_name, cfg.preset, cfg.max_frames,
+                                             cfg.label_noise, cfg.rig),
+                            options);
   std::vector<std::unique_ptr<LocalizationSession>> sessions;
   for (size_t c = 0; c < cfg.configs.size(); ++c)
     sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source->info(),
@@ -190,6 +190,7 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
   j["preset"] = e.config.preset;
   j["map_run"] = e.config.map_run;
   j["label_noise"] = e.config.label_noise;
+  j["rig"] = e.config.rig;
   j["query_odometry"] = e.config.lidar_odometry ? "lidar" : "simulated";
   j["correct_m"] = e.config.correct_m;
   j["wrong_m"] = e.config.wrong_m;

@@ -22,6 +22,8 @@ struct LocalizationExperimentConfig {
   size_t max_frames = 0;  // per run; 0: all
   // Camera labels of every run as a segmentation network's (sim/label_noise.h): 0 perfect.
   int label_noise = 0;
+  // Simulator keys appended to every run's spec: the rig, e.g. "lidar=hdl64,cameras=front".
+  std::string rig;
   // The query runs' odometry from LiDAR odometry on their scans (odometry/), with these
   // settings, instead of the simulator's drifting odometry.
   bool lidar_odometry = false;

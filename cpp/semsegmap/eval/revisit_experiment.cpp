@@ -217,6 +217,7 @@ void appendRun(LocalizationRun& all, LocalizationRun run) {
   all.distance_m += run.distance_m;
   all.stats.frames += run.stats.frames;
   all.stats.total += run.stats.total;
+  all.odometry_is_ground_truth |= run.odometry_is_ground_truth;
 }
 
 // The query frames, read once for every configuration, on the dataset's odometry: one session
@@ -400,6 +401,7 @@ RevisitExperiment evaluateRevisits(FrameSource& source, const RevisitExperimentC
   RevisitExperiment e;
   e.config = cfg;
   e.dataset = source.info().name;
+  e.odometry_is_ground_truth = source.info().odometry_is_ground_truth;
   for (int i = 0; i <= 100; ++i) e.thresholds.push_back(cfg.wrong_m * i / 100.0);
   std::filesystem::create_directories(out / "maps");
   // Models load first: a missing one fails before the frames are read. Map and queries come
@@ -440,6 +442,7 @@ nlohmann::ordered_json toJson(const RevisitExperiment& e) {
   j["wrong_m"] = e.config.wrong_m;
   j["wake_up_frames"] = e.config.wake_up_frames;
   j["wake_up_every"] = e.config.wake_up_every;
+  j["odometry_is_ground_truth"] = e.odometry_is_ground_truth;
   j["n_queries"] = e.queries.size();
   j["n_revisits"] = e.revisits;
   j["queries"] = nlohmann::ordered_json::array();
@@ -494,6 +497,10 @@ std::string revisitTable(const RevisitExperiment& e) {
                   r.wrong, r.localizations.empty() ? "-" : mean, r.revisits_localized, e.revisits);
     t << line;
   }
+  if (e.odometry_is_ground_truth)
+    t << "\n[odometry is the ground truth]: the errors are measured against the poses that the "
+         "query "
+         "frames' local maps were built on\n";
   if (e.config.check_ground_truth) t << groundTruthCheckText(e);
   if (e.config.wake_up_frames > 0) {
     if (e.config.check_ground_truth)

@@ -98,6 +98,7 @@ struct RevisitResult {  // one configuration
 struct RevisitExperiment {
   RevisitExperimentConfig config;
   std::string dataset;
+  bool odometry_is_ground_truth = false;  // the query frames' odometry is the ground truth
   std::vector<RevisitFrame> queries;
   size_t revisits = 0;    // query frames at a revisit
   size_t registered = 0;  // check_ground_truth: query frames whose registration worked

@@ -66,12 +66,6 @@ double SemanticScores::iou(ClassId id) const {
 
 namespace {
 
-// Whether a camera gave the point its class. Every camera of the datasets measured has a colour
-// and a label image in each frame, so the pixel that coloured a point also classed it.
-bool cameraGaveClass(const EnrichedPoint& p) {
-  return p.has_color;
-}
-
 void checkSource(const FrameSource& source) {
   const DatasetInfo& info = source.info();
   const std::string where = "eval semantics: dataset " + info.name;
@@ -104,12 +98,13 @@ std::vector<PointLabel> takeTruth(Frame& frame, const std::string& dataset) {
 }
 
 // The vote map: the config's voxels, every classified point kept (ground and dynamic classes
-// are what the camera is measured on too), so that a voxel holds class votes only.
+// are what the camera is measured on too, so they vote like the others).
 LocalMapConfig voteMapConfig(const LocalMapConfig& c) {
   LocalMapConfig v = c;
   v.remove_dynamic_classes = false;
   v.remove_ground_classes = false;
   v.remove_unknown_class = false;
+  v.remove_unobserved = false;
   v.geometric_ground_removal = false;
   v.min_points_per_voxel = 1;
   return v;
@@ -123,18 +118,17 @@ SemanticsFrame scoreFrame(const Frame& frame, const std::vector<PointLabel>& tru
   out.frame = frame.index;
   EnrichedCloud classified;
   for (size_t i = 0; i < cloud.size(); ++i) {
-    const bool has_class = cameraGaveClass(cloud[i]);
-    out.per_frame.add(truth[i].class_id, has_class, cloud[i].class_id);
-    if (has_class) classified.push_back(cloud[i]);
+    out.per_frame.add(truth[i].class_id, cloud[i].has_class, cloud[i].class_id);
+    if (cloud[i].has_class) classified.push_back(cloud[i]);
   }
   const Eigen::Vector2d robot_xy = T_map_lidar.translation().head<2>();
-  votes.update(classified, T_map_lidar, robot_xy, true);
+  votes.update(classified, T_map_lidar, robot_xy);
   const Eigen::Matrix3f R = T_map_lidar.linear().cast<float>();
   const Eigen::Vector3f t = T_map_lidar.translation().cast<float>();
   for (size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f p = R * Eigen::Vector3f(cloud[i].x, cloud[i].y, cloud[i].z) + t;
     const Voxel* v = votes.find(packVoxelKey(votes.voxelIndex(p)));
-    const bool has_votes = v != nullptr && v->classes.majority().second > 0;
+    const bool has_votes = v != nullptr && v->hasClass();
     out.after_votes.add(truth[i].class_id, has_votes, has_votes ? v->semanticClass() : 0);
   }
   return out;
@@ -144,7 +138,7 @@ void countSegments(const std::vector<Segment>& segments, SemanticsEvaluation& e)
   for (const Segment& s : segments) {
     ++e.segments;
     for (const EnrichedPoint& p : s.last().points)
-      if (cameraGaveClass(p)) {
+      if (p.has_class) {
         ++e.segments_with_class;
         break;
       }

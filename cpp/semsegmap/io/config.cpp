@@ -1,5 +1,6 @@
 #include "semsegmap/io/config.h"
 
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/core/sensor_rig.h"
 #include "semsegmap/core/shown_text.h"
 
@@ -7,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <stdexcept>
@@ -246,6 +248,27 @@ std::string besideConfig(const std::filesystem::path& config, const std::string&
   return (config.parent_path() / file).lexically_normal().string();
 }
 
+// A model named by a config: beside the config as written; when no file is there (a shipped
+// config copied elsewhere loses its ../models), the shipped model of that name, installed or in
+// the source tree, said in one line. Missing everywhere, the path beside the config is kept and
+// the model's loader refuses it by that name.
+std::string modelBesideConfig(const std::filesystem::path& config, const std::string& file,
+                              const char* key) {
+  namespace fs = std::filesystem;
+  const std::string beside = besideConfig(config, file);
+  std::error_code ignored;
+  if (beside.empty() || fs::path(file).is_absolute() || fs::exists(beside, ignored)) return beside;
+  for (const fs::path& dir :
+       {fs::path(SEMSEGMAP_INSTALLED_DATA_DIR), fs::path(SEMSEGMAP_SOURCE_DATA_DIR)}) {
+    const fs::path shipped = dir / "models" / fs::path(file).filename();
+    if (!fs::is_regular_file(shipped, ignored)) continue;
+    note(config.string() + ": " + key + ": " + beside + " does not exist, using the shipped " +
+         shipped.string());
+    return shipped.string();
+  }
+  return beside;
+}
+
 void readSemanticsSection(const std::filesystem::path& path, const YAML::Node& root,
                           SemanticsConfig& c) {
   std::string resize, output, order;
@@ -329,6 +352,7 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"remove_dynamic_classes", set(lm.remove_dynamic_classes)},
                {"remove_ground_classes", set(lm.remove_ground_classes)},
                {"remove_unknown_class", set(lm.remove_unknown_class)},
+               {"remove_unobserved", set(lm.remove_unobserved)},
                {"geometric_ground_removal", set(lm.geometric_ground_removal)},
                {"ground_cell_size_m", set(lm.ground.cell_size_m)},
                {"ground_neighbourhood_cells", count(lm.ground.neighbourhood_cells, 0, 100)},
@@ -355,8 +379,8 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"model", set(d.model)},
                {"model_lidar_only", set(d.model_lidar_only)},
                {"batch", count(d.batch, 1, 4096)}});
-  d.model = besideConfig(path, d.model);
-  d.model_lidar_only = besideConfig(path, d.model_lidar_only);
+  d.model = modelBesideConfig(path, d.model, "descriptor.model");
+  d.model_lidar_only = modelBesideConfig(path, d.model_lidar_only, "descriptor.model_lidar_only");
   auto& loc = c.localization;
   readSection(path, root, "localization",
               {{"k", count(loc.localizer.index.k, 1, 1000)},

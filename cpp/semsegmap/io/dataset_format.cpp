@@ -166,6 +166,10 @@ void writeMetaYaml(const fs::path& path, const DatasetInfo& info) {
   out << YAML::Key << "has_ground_truth_poses" << YAML::Value << info.has_ground_truth_poses;
   out << YAML::Key << "has_point_labels" << YAML::Value << info.has_point_labels;
   out << YAML::Key << "has_odometry" << YAML::Value << info.has_odometry;
+  // Only when true: a dataset converted from SemanticKITTI keeps saying that its odometry is
+  // its ground truth, and other datasets read in builds that do not know the key.
+  if (info.odometry_is_ground_truth)
+    out << YAML::Key << "odometry_is_ground_truth" << YAML::Value << true;
   if (info.first_transient_instance > 0)
     out << YAML::Key << "first_transient_instance" << YAML::Value << info.first_transient_instance;
 
@@ -246,7 +250,8 @@ DatasetInfo readMetaYaml(const fs::path& path) {
            std::to_string(kDatasetFormatVersion));
   p.checkKeys(root, "",
               {"format_version", "name", "rate_hz", "has_ground_truth_poses", "has_point_labels",
-               "has_odometry", "first_transient_instance", "lidar", "cameras", "classes"});
+               "has_odometry", "odometry_is_ground_truth", "first_transient_instance", "lidar",
+               "cameras", "classes"});
 
   DatasetInfo info;
   info.name = p.text(root, "", "name");
@@ -255,6 +260,8 @@ DatasetInfo readMetaYaml(const fs::path& path) {
   info.has_point_labels = p.flag(root, "", "has_point_labels");
   // Optional: datasets written before the key existed always had odometry in frames.csv.
   info.has_odometry = root["has_odometry"] ? p.flag(root, "", "has_odometry") : true;
+  if (root["odometry_is_ground_truth"])
+    info.odometry_is_ground_truth = p.flag(root, "", "odometry_is_ground_truth");
   if (root["first_transient_instance"])  // optional: datasets without traffic ids lack it
     info.first_transient_instance = static_cast<uint16_t>(
         p.integer(root, "", "first_transient_instance", 0, std::numeric_limits<uint16_t>::max()));

@@ -62,6 +62,28 @@ std::vector<double> readTimesFile(const fs::path& path, size_t expected) {
   return times;
 }
 
+// Frame numbers of files from their names, the files put in number order (0, 38, 120 as well as
+// 000000, 000038, 000120); empty unless every name is a frame number.
+std::vector<size_t> sortByFrameNumber(std::vector<fs::path>& files) {
+  std::vector<std::pair<size_t, fs::path>> numbered;
+  for (const fs::path& f : files) {
+    const auto n = frameNumberFromFileName(f.stem().string());
+    if (!n) return {};
+    numbered.emplace_back(*n, f);
+  }
+  std::sort(numbered.begin(), numbered.end());
+  std::vector<size_t> numbers;
+  for (size_t i = 0; i < numbered.size(); ++i) {
+    if (i > 0 && numbered[i].first == numbered[i - 1].first)
+      throw std::runtime_error(numbered[i].second.string() + ": a second scan of frame " +
+                               std::to_string(numbered[i].first) + " (" +
+                               numbered[i - 1].second.filename().string() + ")");
+    files[i] = numbered[i].second;
+    numbers.push_back(numbered[i].first);
+  }
+  return numbers;
+}
+
 // Times of files from their names; nothing unless every name is a time.
 std::optional<std::vector<double>> timesFromNames(const std::vector<fs::path>& files) {
   std::vector<double> times;
@@ -136,6 +158,19 @@ std::optional<double> timeFromFileName(const std::string& stem) {
   return std::nullopt;  // a frame number
 }
 
+std::optional<size_t> frameNumberFromFileName(const std::string& stem) {
+  const bool digits_only = !stem.empty() && std::all_of(stem.begin(), stem.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) != 0;
+  });
+  if (!digits_only || timeFromFileName(stem)) return std::nullopt;
+  return static_cast<size_t>(std::stoull(stem));
+}
+
+std::optional<size_t> FolderReader::frameNumber(size_t index) {
+  if (numbers_.empty()) return std::nullopt;
+  return numbers_.at(index);
+}
+
 FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : dir_(dir) {
   if (!fs::is_directory(dir_)) throw std::runtime_error(dir_.string() + ": no such folder");
   const fs::path rig_path = !options.rig.empty()
@@ -158,6 +193,7 @@ FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : 
   scans_ = listFiles(lidar_dir, &isPointCloudFile);
   if (scans_.empty())
     throw std::runtime_error(lidar_dir.string() + ": no scans (.pcd, .ply or .bin files)");
+  numbers_ = sortByFrameNumber(scans_);
   const fs::path times_path =
       !options.times.empty() ? options.times
                              : (fs::exists(dir_ / "times.txt") ? dir_ / "times.txt" : fs::path());
@@ -166,11 +202,7 @@ FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : 
   } else if (auto from_names = timesFromNames(scans_)) {
     times_ = std::move(*from_names);
   } else {
-    for (size_t i = 0; i < scans_.size(); ++i) times_.push_back(i / info_.rig.rate_hz);
-    if (scans_.size() > 1)
-      note(lidar_dir.string() +
-           ": the scans' names are no times and there is no times file: scans are taken " +
-           shownNumber(1.0 / info_.rig.rate_hz) + " s apart in name order");
+    madeUpTimes(lidar_dir);
   }
   if (!std::is_sorted(times_.begin(), times_.end()))
     throw std::runtime_error(lidar_dir.string() + ": the scan times do not increase in name order");
@@ -178,6 +210,20 @@ FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : 
   pictures_.resize(info_.rig.cameras.size());
   for (size_t c = 0; c < info_.rig.cameras.size(); ++c)
     pairPictures(c, dir_ / rig.camera_folders[c]);
+}
+
+// Scans without times in their names or a times file: scan N at N periods when the names are
+// frame numbers (sparse frames keep their spacing), else one period apart in name order. Such
+// times pair pictures, but no pose file is matched to them (DatasetInfo::has_frame_times).
+void FolderReader::madeUpTimes(const fs::path& lidar_dir) {
+  info_.has_frame_times = false;
+  for (size_t i = 0; i < scans_.size(); ++i)
+    times_.push_back(static_cast<double>(numbers_.empty() ? i : numbers_[i]) / info_.rig.rate_hz);
+  if (scans_.size() < 2) return;
+  note(lidar_dir.string() + ": the scans' names are no times and there is no times file: " +
+       (numbers_.empty()
+            ? "scans are taken " + shownNumber(1.0 / info_.rig.rate_hz) + " s apart in name order"
+            : "scan N is taken at N x " + shownNumber(1.0 / info_.rig.rate_hz) + " s"));
 }
 
 namespace {

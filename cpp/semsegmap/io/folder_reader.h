@@ -1,7 +1,8 @@
 // A folder of a robot's own recordings as a FrameSource (`--dataset folder:DIR`): scans as .pcd,
 // .ply or KITTI .bin files, camera pictures as .png or .jpg, the rig from a rig file
 // (docs/rig-format.md). Scans and pictures are paired by the times in their file names, a times
-// file, or equal file names.
+// file, or equal file names. Scans named by frame numbers (000042.bin) keep them: pose files in
+// KITTI format refer to them (datasets/pose_files.h).
 #pragma once
 
 #include <filesystem>
@@ -34,6 +35,9 @@ std::filesystem::path parseFolderSpec(const std::string& spec, const std::string
 // nanoseconds (>= 18 digits), microseconds (15-17), milliseconds (12-14) or seconds (>= 1e8).
 // Nothing for small integers (frame numbers such as 000042) and for other names.
 std::optional<double> timeFromFileName(const std::string& stem);
+// A file name's stem as a frame number: digits only and no time by timeFromFileName (000042 is
+// 42). Nothing for times and other names.
+std::optional<size_t> frameNumberFromFileName(const std::string& stem);
 
 class FolderReader : public FrameSource {
  public:
@@ -44,14 +48,18 @@ class FolderReader : public FrameSource {
   size_t size() const override { return scans_.size(); }
   Frame frame(size_t index) override;
   double frameTime(size_t index) override { return times_.at(index); }
+  // When every scan is named by a frame number: that number (KITTI pose lines refer to it).
+  std::optional<size_t> frameNumber(size_t index) override;
 
  private:
   void pairPictures(size_t camera, const std::filesystem::path& folder);
+  void madeUpTimes(const std::filesystem::path& lidar_dir);
 
   std::filesystem::path dir_;
   DatasetInfo info_;
   std::vector<std::filesystem::path> scans_;
   std::vector<double> times_;
+  std::vector<size_t> numbers_;  // the scans' frame numbers; empty unless all names are numbers
   double tolerance_s_ = 0.05;
   // pictures_[camera][scan]: the picture paired with the scan, empty when none was near.
   std::vector<std::vector<std::filesystem::path>> pictures_;

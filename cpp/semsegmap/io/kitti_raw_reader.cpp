@@ -128,6 +128,7 @@ KittiRawReader::KittiRawReader(const fs::path& drive_dir) : dir_(normalizedDir(d
   for (const auto& [number, scan] : scans) {
     FrameFiles f;
     f.scan = scan;
+    f.number = number;
     f.image = dir_ / "image_02" / "data" / (scan.stem().string() + ".png");
     if (!fs::is_regular_file(f.image))
       throw std::runtime_error(f.image.string() + ": missing (the image of scan " + scan.string() +
@@ -145,6 +146,8 @@ KittiRawReader::KittiRawReader(const fs::path& drive_dir) : dir_(normalizedDir(d
 
   info_.has_ground_truth_poses = has_oxts_;
   info_.has_odometry = has_oxts_;  // the oxts poses serve as odometry too
+  info_.odometry_is_ground_truth = has_oxts_;
+  info_.has_frame_times = has_times;
   if (has_oxts_) {
     // oxts poses are IMU poses; the LiDAR pose needs the IMU-to-Velodyne mounting.
     const KittiCalibFile imu_to_velo(findCalibration(dir_, "calib_imu_to_velo.txt"));

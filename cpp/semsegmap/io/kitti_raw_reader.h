@@ -31,11 +31,13 @@ class KittiRawReader : public FrameSource {
   Frame frame(size_t index) override;
   // Known from the listing: pose files pair scans by time without reading them.
   double frameTime(size_t index) override { return frames_.at(index).timestamp_s; }
+  std::optional<size_t> frameNumber(size_t index) override { return frames_.at(index).number; }
 
  private:
   struct FrameFiles {
     std::filesystem::path scan, image, oxts;
     double timestamp_s = 0.0;
+    size_t number = 0;  // the frame number of the scan's name
   };
   Pose oxtsPose(const std::filesystem::path& oxts_file) const;
 

@@ -13,6 +13,8 @@ void writeLabelSetInfo(const std::filesystem::path& dir, const LabelSetInfo& inf
   out << YAML::BeginMap;
   out << YAML::Key << "class_map" << YAML::Value << info.class_map;
   out << YAML::Key << "frames" << YAML::Value << info.frames;
+  if (info.dataset_frames > 0)
+    out << YAML::Key << "dataset_frames" << YAML::Value << info.dataset_frames;
   out << YAML::Key << "cameras" << YAML::Value << info.cameras;
   out << YAML::Key << "dataset" << YAML::Value << info.dataset;
   out << YAML::Key << "model" << YAML::Value << info.model;
@@ -31,10 +33,12 @@ LabelSetInfo readLabelSetInfo(const std::filesystem::path& dir) {
   const YAML::Node root = loadYamlFile(path);
   const YamlFields f(path);
   f.expectMap(root, "the top level");
-  f.checkKeys(root, "", {"class_map", "frames", "cameras", "dataset", "model"});
+  f.checkKeys(root, "", {"class_map", "frames", "dataset_frames", "cameras", "dataset", "model"});
   LabelSetInfo info;
   info.class_map = f.text(root, "", "class_map");
   info.frames = static_cast<size_t>(f.integer(root, "", "frames", 1, 1LL << 40));
+  if (root["dataset_frames"])
+    info.dataset_frames = static_cast<size_t>(f.integer(root, "", "dataset_frames", 1, 1LL << 40));
   info.cameras = static_cast<size_t>(f.integer(root, "", "cameras", 1, 64));
   if (root["dataset"]) info.dataset = f.text(root, "", "dataset");
   if (root["model"]) info.model = f.text(root, "", "model");

@@ -184,6 +184,7 @@ NcltReader::NcltReader(const fs::path& session_dir)
   info_.classes = ClassTable::Default();
   info_.has_ground_truth_poses = !gt.empty();
   info_.has_odometry = !gt.empty();  // the ground truth serves as odometry too
+  info_.odometry_is_ground_truth = !gt.empty();
   info_.has_point_labels = false;
 }
 

@@ -71,6 +71,8 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   j["frames"] = run.stats.frames;
   j["distance_m"] = run.distance_m;
   j["has_ground_truth"] = !run.trajectory_gt.empty();
+  // The errors below measured against the very poses the local map was built on.
+  j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
   j["n_localizations"] = s.localizations;
   j["n_error_below_1m"] = s.below_1m;
   j["n_error_below_5m"] = s.below_5m;
@@ -128,6 +130,7 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
     j["ate_slam_aligned"] = errorJson(errors->slam_aligned);
   }
   j["has_ground_truth"] = errors.has_value();
+  j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
   return jsonText(j);
 }
 

@@ -112,6 +112,7 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
   for (const auto& [number, scan] : scans) {
     FrameFiles f;
     f.scan = scan;
+    f.number = number;
     if (has_images) {
       f.image = image_dir / (scan.stem().string() + ".png");
       if (!fs::is_regular_file(f.image))
@@ -152,6 +153,8 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
   info_.classes = ClassTable::Default();
   info_.has_ground_truth_poses = has_poses;
   info_.has_odometry = has_poses;  // the poses serve as odometry too
+  info_.odometry_is_ground_truth = has_poses;
+  info_.has_frame_times = has_times;
   info_.has_point_labels = has_labels;
 }
 

@@ -55,12 +55,14 @@ class SemanticKittiReader : public FrameSource {
   Frame frame(size_t index) override;
   // Known from the listing: pose files pair scans by time without reading them.
   double frameTime(size_t index) override { return frames_.at(index).timestamp_s; }
+  std::optional<size_t> frameNumber(size_t index) override { return frames_.at(index).number; }
 
  private:
   struct FrameFiles {
     std::filesystem::path scan, labels;  // labels empty when the sequence has none
     std::filesystem::path image;         // empty when the sequence has no image_2
     double timestamp_s = 0.0;
+    size_t number = 0;  // the frame number of the scan's name
     std::optional<Pose> T_world_lidar;
   };
   std::filesystem::path dir_;

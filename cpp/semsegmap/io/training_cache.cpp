@@ -3,7 +3,7 @@
 //   u64 n, n x observation | u64 FNV-1a of every byte before it
 // str = u32 length + bytes; observation = u16 instance, u16 class, u16 source, i64 segment,
 //   u32 n_points, f32 purity, 3 x f32 centroid, u32 count, count x 6 f32, count x u16 class,
-//   count x u8 colored.
+//   count x u8 modalities (1: has colour, 2: has a class).
 #include "semsegmap/io/training_cache.h"
 
 #include <algorithm>
@@ -20,7 +20,9 @@ namespace {
 
 constexpr std::string_view kMagic("SSMTRAIN", 8);
 // 3: the checksum covers the whole file (core/binary_io.h), as in the other formats.
-constexpr uint32_t kVersion = 3;
+// 4: a point's byte holds whether it has a class besides whether it has colour (unobserved
+// points); a cache of another version is extracted again.
+constexpr uint32_t kVersion = 4;
 constexpr size_t kFixedObservationBytes = 2 + 2 + 2 + 8 + 4 + 4 + 12 + 4;
 constexpr size_t kPointBytes = 6 * 4 + 2 + 1;
 
@@ -35,7 +37,7 @@ void putObservation(BinaryWriter& w, const TrainingObservation& o) {
   w.put(static_cast<uint32_t>(o.size()));
   w.putArray(o.xyzhsv);
   w.putArray(o.classes);
-  w.putArray(o.colored);
+  w.putArray(o.modalities);
 }
 
 TrainingObservation getObservation(BinaryReader& r, size_t sources) {
@@ -52,7 +54,7 @@ TrainingObservation getObservation(BinaryReader& r, size_t sources) {
   r.need(n, kPointBytes, "the points of an observation");
   o.xyzhsv = r.getArray<float>(6 * size_t{n}, "the points of an observation");
   o.classes = r.getArray<ClassId>(n, "the points of an observation");
-  o.colored = r.getArray<uint8_t>(n, "the points of an observation");
+  o.modalities = r.getArray<uint8_t>(n, "the points of an observation");
   const auto finite = [](float v) { return std::isfinite(v); };
   if (!std::isfinite(o.purity) || !o.centroid.allFinite() ||
       !std::all_of(o.xyzhsv.begin(), o.xyzhsv.end(), finite))

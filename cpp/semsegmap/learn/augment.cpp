@@ -176,7 +176,10 @@ EnrichedCloud dropModalities(const EnrichedCloud& cloud, bool drop_color, bool d
       p.h = p.s = p.v = 0;
       p.has_color = false;
     }
-    if (drop_classes) p.class_id = cls::kUnknown;
+    if (drop_classes) {
+      p.class_id = cls::kUnknown;
+      p.has_class = false;
+    }
   }
   return out;
 }

@@ -67,8 +67,9 @@ EnrichedCloud relabelPoints(const EnrichedCloud& cloud, double fraction, int num
 // building or vegetation behind them. Classes without a partner keep theirs.
 EnrichedCloud confuseSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng);
 
-// Every point without colour (grey, has_color false) when drop_color, of class unknown when
-// drop_classes: the observation as a sensor without that modality gives it.
+// Every point without colour (grey, has_color false) when drop_color, without a class
+// (unobserved, has_class false) when drop_classes: the observation as a sensor without that
+// modality gives it.
 EnrichedCloud dropModalities(const EnrichedCloud& cloud, bool drop_color, bool drop_classes);
 
 // All of the above with random strengths within `config`.

@@ -21,7 +21,8 @@ EnrichedCloud TrainingObservation::cloud() const {
     EnrichedPoint& p = out[i];
     p.x = f[0], p.y = f[1], p.z = f[2], p.h = f[3], p.s = f[4], p.v = f[5];
     p.class_id = classes[i];
-    p.has_color = colored[i] != 0;
+    p.has_color = (modalities[i] & kHasColor) != 0;
+    p.has_class = (modalities[i] & kHasClass) != 0;
     p.instance_id = instance;
   }
   return out;
@@ -54,12 +55,14 @@ TrainingObservation compact(const SegmentObservation& obs, uint16_t source, Segm
   }
   t.xyzhsv.reserve(6 * keep.size());
   t.classes.reserve(keep.size());
-  t.colored.reserve(keep.size());
+  t.modalities.reserve(keep.size());
   for (uint32_t i : keep) {
     const EnrichedPoint& p = obs.points[i];
     t.xyzhsv.insert(t.xyzhsv.end(), {p.x, p.y, p.z, p.h, p.s, p.v});
     t.classes.push_back(p.class_id);
-    t.colored.push_back(p.has_color ? 1 : 0);
+    t.modalities.push_back(
+        static_cast<uint8_t>((p.has_color ? TrainingObservation::kHasColor : 0) |
+                             (p.has_class ? TrainingObservation::kHasClass : 0)));
   }
   return t;
 }

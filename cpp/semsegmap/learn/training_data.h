@@ -29,7 +29,9 @@ struct TrainingObservation {
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();  // map frame
   std::vector<float> xyzhsv;                           // 6 floats a stored point, map frame
   std::vector<ClassId> classes;                        // a class a stored point
-  std::vector<uint8_t> colored;                        // has_color a stored point
+  std::vector<uint8_t> modalities;                     // a stored point's kHasColor | kHasClass
+
+  static constexpr uint8_t kHasColor = 1, kHasClass = 2;
 
   size_t size() const { return classes.size(); }
   EnrichedCloud cloud() const;  // instance_id of the points is `instance`

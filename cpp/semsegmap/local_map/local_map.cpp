@@ -70,12 +70,23 @@ const Voxel* LocalMap::find(VoxelKey key) const {
   return it == voxels_.end() ? nullptr : &it->second;
 }
 
+// A point with a class is filtered by it; an unobserved one by its geometry, or as unobserved
+// when the scan has classes elsewhere and the config drops what no camera saw.
+bool LocalMap::dropped(const EnrichedPoint& q, bool ground, bool drop_unobserved) const {
+  if (ground && (config_.geometric_ground_removal || !q.has_class)) return true;
+  if (!q.has_class) return drop_unobserved;
+  return drop_class_[q.class_id] || (config_.remove_unknown_class && q.class_id == cls::kUnknown);
+}
+
 LocalMapUpdate LocalMap::update(const EnrichedCloud& scan, const Pose& T_map_lidar,
-                                const Eigen::Vector2d& robot_xy, bool scan_has_semantics) {
+                                const Eigen::Vector2d& robot_xy) {
   LocalMapUpdate out;
-  const bool geometric = config_.geometric_ground_removal || !scan_has_semantics;
+  size_t classified = 0;
+  for (const EnrichedPoint& q : scan) classified += q.has_class;
+  out.points_unobserved = scan.size() - classified;
+  const bool geometric = config_.geometric_ground_removal || out.points_unobserved > 0;
   if (geometric) ground_mask_ = markGround(scan, T_map_lidar, config_.ground);
-  const bool drop_unknown = scan_has_semantics && config_.remove_unknown_class;
+  const bool drop_unobserved = config_.remove_unobserved && classified > 0;
   const Eigen::Matrix3f R = T_map_lidar.linear().cast<float>();
   const Eigen::Vector3f t = T_map_lidar.translation().cast<float>();
   const Eigen::Vector2f center = robot_xy.cast<float>();
@@ -85,8 +96,7 @@ LocalMapUpdate LocalMap::update(const EnrichedCloud& scan, const Pose& T_map_lid
 
   for (size_t k = 0; k < scan.size(); ++k) {
     const EnrichedPoint& q = scan[k];
-    if ((scan_has_semantics && drop_class_[q.class_id]) ||
-        (drop_unknown && q.class_id == cls::kUnknown) || (geometric && ground_mask_[k])) {
+    if (dropped(q, geometric && ground_mask_[k], drop_unobserved)) {
       ++out.points_filtered;
       continue;
     }
@@ -111,10 +121,13 @@ LocalMapUpdate LocalMap::update(const EnrichedCloud& scan, const Pose& T_map_lid
       v.saturation += (q.s - v.saturation) * inv_n;
       v.value += (q.v - v.value) * inv_n;
     }
-    if (dynamic_class_[q.class_id])
-      ++v.n_dynamic;
-    else
-      v.classes.add(q.class_id);
+    if (q.has_class) {
+      ++v.n_classified;
+      if (dynamic_class_[q.class_id])
+        ++v.n_dynamic;
+      else
+        v.classes.add(q.class_id);
+    }
     if (q.instance_id != 0) v.instances.add(q.instance_id);
     ++out.points_inserted;
     // Considered for activation once the scan is in, when its votes are counted; in the order
@@ -126,7 +139,8 @@ LocalMapUpdate LocalMap::update(const EnrichedCloud& scan, const Pose& T_map_lid
   }
   for (VoxelKey key : pending) {
     Voxel& v = voxels_.at(key);
-    if (v.n_dynamic > config_.dynamic_vote_share * v.n_points) continue;
+    // The share among the points that have a class: unobserved points say nothing either way.
+    if (v.n_dynamic > config_.dynamic_vote_share * v.n_classified) continue;
     v.active = true;
     ++active_count_;
     out.newly_active.push_back(key);

@@ -36,12 +36,18 @@ struct LocalMapConfig {
   DynamicRemoval dynamic_removal = DynamicRemoval::kVoxel;
   double dynamic_vote_share = 0.5;
   bool remove_ground_classes = true;  // road, sidewalk, terrain: the ground flag
-  // Points no camera saw (class unknown) in a scan that does carry semantics: without a class
-  // they cannot be filtered as ground or dynamic, and one stray ground patch glues every segment
-  // it touches into one.
+  // Points the network called unknown (or ignore): what it could not name is mostly clutter.
+  // Unobserved points (no class at all, EnrichedPoint::has_class) are not of this class.
   bool remove_unknown_class = true;
-  // Geometric ground removal; always applied to scans without any semantics (data with no
-  // labels), and on request to labelled ones whose ground labels are not trusted.
+  // Unobserved points of a scan in which other points have a class: the paper's rig, whose
+  // cameras cover its LiDAR, drops them, since what no camera saw cannot be filtered by class.
+  // Off, they are kept with their geometry alone (a front camera on a 360-degree LiDAR sees a
+  // quarter of the scan); their ground is then removed geometrically, and their class comes
+  // from the votes of the frames in which a camera sees their voxel.
+  bool remove_unobserved = false;
+  // Geometric ground removal of every point, also those with a class, for labels whose ground is
+  // not trusted. Unobserved points always have their ground removed geometrically (all points
+  // of a scan without any semantics).
   bool geometric_ground_removal = false;
   GroundRemovalConfig ground;
 };
@@ -51,6 +57,7 @@ struct LocalMapUpdate {
   std::vector<VoxelKey> removed;  // left the cylinder (only voxels that were active)
   size_t points_inserted = 0;
   size_t points_filtered = 0;
+  size_t points_unobserved = 0;  // of the scan, before filtering: no class (has_class false)
 };
 
 class LocalMap {
@@ -58,11 +65,13 @@ class LocalMap {
   LocalMap(const LocalMapConfig& config, const ClassTable& classes);
 
   // Fuses one enriched scan (LiDAR frame) taken at T_map_lidar, then moves the cylinder to the
-  // robot's position `robot_xy` and drops what left it. `scan_has_semantics` is false for data
-  // with no labels at all: then every point is kept whatever its class and the ground is removed
-  // geometrically.
+  // robot's position `robot_xy` and drops what left it. Points with a class are filtered by it
+  // (ground, dynamic, unknown); unobserved points (has_class false) have no class to filter by:
+  // their ground is removed geometrically and they vote for no class. A moving object that no
+  // camera saw therefore stays, unless its voxels collect dynamic votes before they become
+  // active. A scan without any class (LiDAR only) is thus all geometry.
   LocalMapUpdate update(const EnrichedCloud& scan, const Pose& T_map_lidar,
-                        const Eigen::Vector2d& robot_xy, bool scan_has_semantics = true);
+                        const Eigen::Vector2d& robot_xy);
 
   const Voxel* find(VoxelKey key) const;
   Eigen::Vector3i voxelIndex(const Eigen::Vector3f& p) const;
@@ -85,6 +94,8 @@ class LocalMap {
   // voxels in the tiles its rim crosses, instead of sweeping every voxel every frame.
   std::unordered_map<uint64_t, std::vector<VoxelKey>> tiles_;
   size_t active_count_ = 0;
+  bool dropped(const EnrichedPoint& q, bool ground, bool drop_unobserved) const;
+
   std::vector<uint8_t> ground_mask_;  // scratch, reused every update
 };
 

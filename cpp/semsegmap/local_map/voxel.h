@@ -40,13 +40,18 @@ struct Voxel {
   // to 0.0, not 0.5), saturation and value as plain running means, over coloured points only.
   uint32_t n_colored = 0;
   float hue_cos = 0, hue_sin = 0, saturation = 0, value = 0;
-  Votes<ClassId, 4> classes;
+  Votes<ClassId, 4> classes;     // of the points that came with a class (has_class)
   Votes<uint16_t, 3> instances;  // ground truth, when known
+  uint32_t n_classified = 0;     // points that came with a class, dynamic ones included
   uint32_t n_dynamic = 0;        // points of dynamic classes (counted, not voted: DynamicRemoval)
   uint32_t pending_scan = 0;     // the update that last considered it for activation (1-based)
   bool active = false;
 
   float hue() const;  // in [0, 1)
+  // False while no point of it came with a static class: it is unobserved, and semanticClass()
+  // (then cls::kUnknown) means nothing. Votes of earlier frames stay, so a voxel keeps the class
+  // a camera gave it after it has left the picture.
+  bool hasClass() const { return classes.majority().second > 0; }
   ClassId semanticClass() const { return classes.majority().first; }
 };
 

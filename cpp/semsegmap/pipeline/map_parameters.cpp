@@ -1,5 +1,6 @@
 #include "semsegmap/pipeline/map_parameters.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -25,6 +26,21 @@ std::string exact(Integer value) {
 
 }  // namespace
 
+// The one place where settings that older builds recorded under other rules are read as this
+// build would have recorded them.
+MapParameters upgradeMapParameters(MapParameters recorded) {
+  const auto find = [&](const std::string& key) {
+    return std::find_if(recorded.begin(), recorded.end(),
+                        [&](const auto& kv) { return kv.first == key; });
+  };
+  // Before unobserved points were told apart from class unknown, remove_unknown_class dropped
+  // both: such a map was built with remove_unobserved equal to it.
+  const auto unknown = find("local_map.remove_unknown_class");
+  if (unknown != recorded.end() && find("local_map.remove_unobserved") == recorded.end())
+    recorded.insert(unknown + 1, {"local_map.remove_unobserved", unknown->second});
+  return recorded;
+}
+
 MapParameters mapParametersOf(const PipelineConfig& config) {
   const EnrichmentConfig& e = config.enrichment;
   const LocalMapConfig& lm = config.local_map;
@@ -41,6 +57,7 @@ MapParameters mapParametersOf(const PipelineConfig& config) {
       {"local_map.dynamic_vote_share", exact(lm.dynamic_vote_share)},
       {"local_map.remove_ground_classes", exact(lm.remove_ground_classes)},
       {"local_map.remove_unknown_class", exact(lm.remove_unknown_class)},
+      {"local_map.remove_unobserved", exact(lm.remove_unobserved)},
       {"local_map.geometric_ground_removal", exact(lm.geometric_ground_removal)},
       {"local_map.ground_cell_size_m", exact(lm.ground.cell_size_m)},
       {"local_map.ground_neighbourhood_cells", exact(lm.ground.neighbourhood_cells)},
@@ -59,7 +76,8 @@ void checkMapParameters(const std::string& map_name, const TargetMap& map,
                         const PipelineConfig& config, MapSettingsCheck check,
                         const std::string& remedy) {
   if (map.parameters.empty()) return;
-  const auto differences = mapParameterDifferences(map.parameters, mapParametersOf(config));
+  const auto differences =
+      mapParameterDifferences(upgradeMapParameters(map.parameters), mapParametersOf(config));
   if (differences.empty()) return;
   if (check == MapSettingsCheck::kRefuse)
     throw std::runtime_error(describeDifference(map_name, differences.front()) + " (" + remedy +

@@ -11,6 +11,10 @@ namespace semsegmap {
 
 MapParameters mapParametersOf(const PipelineConfig& config);
 
+// A map's recorded settings as this build records them: keys that older builds did not write
+// are added with the value that their rules implied. Applied before every comparison.
+MapParameters upgradeMapParameters(MapParameters recorded);
+
 // What a difference between a map's recorded settings and the configuration's does: refuse (a
 // map grown with another voxel size or growing radius holds segments the run never makes, and
 // localized nothing with exit 0), or go on with a warning for each difference.

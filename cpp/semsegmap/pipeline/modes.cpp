@@ -179,7 +179,9 @@ LocalizationSession::LocalizationSession(const PipelineConfig& config, const Dat
       describer_(describer),
       localizer_(checkedMap(std::move(map), *describer, config, settings),
                  config.localization.localizer),
-      pipeline_(config, info, PoseSource::kOdometry, describer) {}
+      pipeline_(config, info, PoseSource::kOdometry, describer) {
+  run_.odometry_is_ground_truth = info.odometry_is_ground_truth;
+}
 
 void LocalizationSession::process(const Frame& frame) {
   FrameResult r = pipeline_.process(frame);

@@ -101,6 +101,9 @@ struct LocalizationRun {
   std::vector<Pose> trajectory_gt;    // empty without ground truth
   std::vector<Pose> trajectory_odom;  // the robot's own estimate, in its odometry frame
   double distance_m = 0.0;            // driven, by odometry
+  // The odometry was the ground truth itself (DatasetInfo): the errors say how the run does
+  // with perfect odometry, and the summaries mark them so.
+  bool odometry_is_ground_truth = false;
   RunStats stats;
 };
 

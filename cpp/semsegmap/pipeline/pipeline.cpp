@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include "semsegmap/core/diagnostics.h"
 
 namespace semsegmap {
 
@@ -107,6 +111,36 @@ Eigen::VectorXf Pipeline::finalDescriptor(const Segment& s) const {
   return describer_->describe({in}).row(0).transpose();
 }
 
+// Frames enough to judge a run's coverage: a robot starting in front of a wall is not a rig.
+constexpr size_t kCoverageFrames = 10;
+// Below this share of points with a class, the semantic distance and the class histograms have
+// next to nothing to work with.
+constexpr double kLowCoverage = 0.1;
+
+void Pipeline::checkCameraCoverage(const LocalMapUpdate& update, size_t points, bool at_end) {
+  if (coverage_.checked) return;
+  if (!at_end) {
+    ++coverage_.frames;
+    coverage_.points += points;
+    coverage_.unobserved += update.points_unobserved;
+    if (coverage_.frames < kCoverageFrames) return;
+  }
+  coverage_.checked = true;
+  const size_t classified = coverage_.points - coverage_.unobserved;
+  // No class anywhere is LiDAR-only data, geometry by design (the descriptor choice says so).
+  if (coverage_.points == 0 || classified == 0) return;
+  const double share = static_cast<double>(classified) / static_cast<double>(coverage_.points);
+  const std::string seen = "cameras gave a class to " + std::to_string(std::lround(100 * share)) +
+                           " % of the points of the first " + std::to_string(coverage_.frames) +
+                           " frames";
+  if (config_.local_map.remove_unobserved && share < 0.9)
+    warn(seen +
+         ", and local_map.remove_unobserved drops the rest: set it to false for a rig "
+         "whose cameras do not cover the LiDAR (config/lidar-camera.yaml)");
+  else if (share < kLowCoverage)
+    warn(seen + ": the semantic part of the segmentation and the descriptor is nearly off");
+}
+
 FrameResult Pipeline::process(const Frame& frame) {
   FrameResult r;
   r.frame_index = frame.index;
@@ -126,13 +160,9 @@ FrameResult Pipeline::process(const Frame& frame) {
   for (const auto& p : cloud) r.colored_points += p.has_color;
 
   t0 = std::chrono::steady_clock::now();
-  // A scan carries semantics when the cameras gave classes or the points came with classes.
-  bool semantic = false;
-  for (const auto& cam : frame.cameras) semantic = semantic || !cam.label.empty();
-  for (size_t k = 0; !semantic && k < frame.point_labels.size(); ++k)
-    semantic = frame.point_labels[k].class_id != cls::kUnknown;
   r.map_update = local_map_.update(cloud, r.T_local_base * info_.rig.T_base_lidar,
-                                   r.T_local_base.translation().head<2>(), semantic);
+                                   r.T_local_base.translation().head<2>());
+  checkCameraCoverage(r.map_update, cloud.size(), false);
   r.times.local_map_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -155,6 +185,7 @@ FrameResult Pipeline::process(const Frame& frame) {
 }
 
 std::vector<Segment> Pipeline::finish(std::vector<Eigen::VectorXf>* descriptors) {
+  checkCameraCoverage({}, 0, true);
   std::vector<Segment> segments = segmenter_.finishAll();
   if (descriptors) {
     descriptors->clear();

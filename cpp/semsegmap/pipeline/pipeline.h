@@ -41,7 +41,7 @@ struct FrameResult {
   size_t frame_index = 0;
   Pose T_local_base = Pose::Identity();  // the pose the local map is built with: its frame is
                                          // the world (ground-truth poses) or odometry
-  size_t points = 0, colored_points = 0;
+  size_t points = 0, colored_points = 0;  // unobserved ones: map_update.points_unobserved
   LocalMapUpdate map_update;
   SegmentationUpdate segmentation;
   // Parallel to segmentation.finished when a describer is set: the final observation's
@@ -86,6 +86,9 @@ class Pipeline {
   void describe(const std::vector<SegmentId>& ids, size_t frame_index);
   // The descriptor of a finished segment's final observation.
   Eigen::VectorXf finalDescriptor(const Segment& s) const;
+  // Counts the points a camera gave a class; after the first frames (or at the end of a shorter
+  // run), warns once when so few have one that the semantic part is nearly off.
+  void checkCameraCoverage(const LocalMapUpdate& update, size_t points, bool at_end);
 
   PipelineConfig config_;
   DatasetInfo info_;
@@ -94,6 +97,10 @@ class Pipeline {
   IncrementalSegmenter segmenter_;
   std::shared_ptr<Describer> describer_;
   std::unordered_map<SegmentId, DescribedSegment> described_;
+  struct {
+    size_t frames = 0, points = 0, unobserved = 0;
+    bool checked = false;
+  } coverage_;
 };
 
 }  // namespace semsegmap

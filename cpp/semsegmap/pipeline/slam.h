@@ -28,6 +28,8 @@ struct SlamRun {
   TargetMap map;  // the segments at their corrected positions (duplicates removed)
   RunStats stats;
   double graph_ms = 0.0;  // pose graph optimization, summed
+  // The odometry was the ground truth itself (DatasetInfo): its error says nothing.
+  bool odometry_is_ground_truth = false;
 };
 
 SlamRun runSlam(FrameSource& source, const PipelineConfig& config,

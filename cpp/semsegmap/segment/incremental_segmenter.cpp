@@ -93,6 +93,7 @@ std::vector<VoxelKey> IncrementalSegmenter::addVoxels(const LocalMap& map,
     e.attributes.position = v->centroid;
     e.attributes.hue = v->hue();
     e.attributes.has_color = v->n_colored > 0;
+    e.attributes.has_class = v->hasClass();
     e.attributes.class_id = v->semanticClass();
     VoxelEntry* entry = &voxels_.emplace(key, e).first->second;
     cells_[cellOf(e.attributes.position)].push_back({key, e.attributes, entry});
@@ -225,9 +226,10 @@ void IncrementalSegmenter::observe(SegmentState& st, const LocalMap& map, size_t
     p.h = v->hue();
     p.s = v->saturation;
     p.v = v->value;
+    p.has_class = v->hasClass();
     p.class_id = v->semanticClass();
     p.instance_id = v->instances.majority().first;
-    classes.add(p.class_id);
+    if (p.has_class) classes.add(p.class_id);
     if (p.instance_id) instances.add(p.instance_id);
     sum += v->centroid.cast<double>();
     obs.points.push_back(p);

@@ -24,7 +24,8 @@ SemanticDistance::SemanticDistance(const SegmentationConfig& c)
 float SemanticDistance::squared(const DistanceVoxel& a, const DistanceVoxel& b) const {
   float d2 = (a.position - b.position).squaredNorm();
   if (a.has_color && b.has_color && hueDifference(a.hue, b.hue) > t_h_) d2 += p_h2_;
-  if (a.class_id != b.class_id && a.class_id != cls::kUnknown && b.class_id != cls::kUnknown)
+  if (a.has_class && b.has_class && a.class_id != b.class_id && a.class_id != cls::kUnknown &&
+      b.class_id != cls::kUnknown)
     d2 += p_c2_;
   return d2;
 }

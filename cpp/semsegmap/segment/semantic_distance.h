@@ -28,6 +28,7 @@ struct DistanceVoxel {
   Eigen::Vector3f position = Eigen::Vector3f::Zero();
   float hue = 0.0f;
   bool has_color = false;
+  bool has_class = false;  // false: unobserved, class_id means nothing
   ClassId class_id = cls::kUnknown;
 };
 
@@ -37,8 +38,8 @@ float hueDifference(float h1, float h2);
 class SemanticDistance {
  public:
   explicit SemanticDistance(const SegmentationConfig& config);
-  // A voxel without colour or of unknown class carries no evidence for a penalty: only what two
-  // voxels both know can keep them apart.
+  // A voxel without colour, unobserved or of class unknown carries no evidence for a penalty:
+  // only what two voxels both know can keep them apart.
   float squared(const DistanceVoxel& a, const DistanceVoxel& b) const;
   // Region growing asks this for every neighbour of every new voxel: inline, and most pairs are
   // decided by their positions alone.

@@ -1,6 +1,7 @@
 #include "semsegmap/sim/simulator.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <Eigen/Geometry>
 
@@ -9,6 +10,27 @@
 #include "semsegmap/sim/lidar_sim.h"
 
 namespace semsegmap::sim {
+
+namespace {
+
+// Only the named cameras stay on the rig, in the rig's order; a name the rig lacks is refused.
+void keepCameras(const std::vector<std::string>& names, SensorRig& rig) {
+  if (names.empty()) return;
+  std::string known;
+  for (const Camera& c : rig.cameras) known += (known.empty() ? "" : ", ") + c.name;
+  for (const std::string& n : names)
+    if (std::none_of(rig.cameras.begin(), rig.cameras.end(),
+                     [&](const Camera& c) { return c.name == n; }))
+      throw std::invalid_argument("simulator: no camera '" + n + "' on the rig (" + known + ")");
+  rig.cameras.erase(std::remove_if(rig.cameras.begin(), rig.cameras.end(),
+                                   [&](const Camera& c) {
+                                     return std::find(names.begin(), names.end(), c.name) ==
+                                            names.end();
+                                   }),
+                    rig.cameras.end());
+}
+
+}  // namespace
 
 Simulator::Simulator(const SimConfig& config)
     : config_(config),
@@ -30,6 +52,7 @@ Simulator::Simulator(const SimConfig& config)
   label_noise_ = labelNoiseOfLevel(config.label_noise);
   info_.rig = config_.rig;
   if (!config_.render_cameras) info_.rig.cameras.clear();
+  keepCameras(config_.camera_names, info_.rig);
   info_.classes = ClassTable::Default();
   info_.has_ground_truth_poses = true;
   info_.has_odometry = true;  // the simulated drifting odometry

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/sim/label_noise.h"
@@ -27,6 +28,9 @@ struct SimConfig {
   TrajectoryConfig trajectory;
   OdometryNoise odometry;
   bool render_cameras = true;
+  // The rig's cameras to keep by name (left, front, right); empty: all. One front camera on a
+  // 360-degree LiDAR (lidar hdl64) is the commonest real rig: a quarter of each scan in view.
+  std::vector<std::string> camera_names;
   // Motion distortion: the LiDAR sweeps its columns over the frame period (hfov / 360 of it,
   // one turn per frame) while the vehicle drives on, each point in the LiDAR frame of its own
   // time, Frame::point_times filled. Off: every column at the frame's pose, as before.
