@@ -152,6 +152,9 @@ TEST(EvalSemantics, RealMiniKittiWithARealNetwork) {
   // classed is at least what the camera alone gives.
   EXPECT_GE(e.after_votes.correctShare(), e.per_frame.classifiedShare() * e.per_frame.accuracy());
   EXPECT_GT(e.after_votes.classifiedShare(), e.per_frame.classifiedShare());
+  // Unobserved points stay in the map: some segments have a class, most lie outside the picture.
+  EXPECT_GT(e.segments_with_class, 0u);
+  EXPECT_LT(e.segments_with_class, e.segments / 2);
 }
 
 }  // namespace
