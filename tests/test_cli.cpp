@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "command_result.h"
+#include "mini_kitti.h"
 #include "temp_dir.h"
 
 namespace semsegmap {
@@ -136,6 +137,10 @@ const std::vector<CommandOptions> kAllCommands = {
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "map-frames",
       "query-frames", "configs", "place-radius", "check-ground-truth", "wake-up", "out"},
      {"world-seed", "preset", "map-run"}},
+    {"eval semantics",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
+      "max-frames"},
+     {"world-seed", "configs", "map-frames"}},
     {"eval paper",
      {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run", "config",
       "models", "descriptors", "threads", "descriptor-run", "map-run", "query-runs"},
@@ -146,7 +151,8 @@ const std::vector<CommandOptions> kAllCommands = {
 // SEMSEGMAP_WITH_TORCH.
 bool built(const std::string& command) {
   if (command == "train") return SEMSEGMAP_WITH_TORCH;
-  if (command == "eval revisits") return true;  // any recording with ground truth
+  if (command == "eval revisits") return true;   // any recording with ground truth
+  if (command == "eval semantics") return true;  // any dataset with per-point ground truth
   if (command.rfind("simulate", 0) == 0 || command == "demo" || command.rfind("eval", 0) == 0)
     return SEMSEGMAP_WITH_SIM;
   return true;
@@ -1115,6 +1121,33 @@ TEST(CliEvalRevisits, RunsOnTheRealKittiScansInEveryBuild) {
       readFile(out / "eigen-kitti" / "summary.json").find("\"odometry_is_ground_truth\": true"),
       std::string::npos);
   EXPECT_GT(std::filesystem::file_size(out / "revisits.png"), 1000u);
+}
+
+// The README's and docs/class-maps.md's eval semantics, as typed: a label set made with a real
+// network on the real mini KITTI frames, then measured against SemanticKITTI's labels.
+TEST(CliEvalSemantics, LabelsThenEvalOnTheRealMiniKitti) {
+  SEMSEGMAP_SKIP_WITHOUT_MINI_KITTI();
+  if (!std::filesystem::exists(test_support::kEspNet))
+    GTEST_SKIP() << "no ESPNetv2 network (" << test_support::kEspNet.string() << ")";
+  TempDir tmp;
+  const std::filesystem::path net = test_support::writeEspNetConfig(tmp.path(), "config");
+  const std::string dataset =
+      " --dataset semantickitti:" + test_support::miniKittiSequence(tmp.path(), "05").string();
+  const std::filesystem::path labels = tmp.path() / "labels-05", out = tmp.path() / "semantics";
+  Result r = run("label" + dataset + " --config " + net.string() + " --out " + labels.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("eval semantics" + dataset + " --labels " + labels.string() +
+          " --config config/lidar-camera.yaml --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("  after votes "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("map segments with a class: "), std::string::npos) << r.out;
+  const std::string json = readFile(out / "semantics.json");
+  EXPECT_NE(json.find("\"frames\": 10"), std::string::npos) << json.substr(0, 600);
+  EXPECT_NE(json.find("\"after_votes\""), std::string::npos);
+  // Without a label set or a network there is nothing to measure: one line naming the frame.
+  r = run("eval semantics" + dataset + " --config config/lidar-camera.yaml --out " + out.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("frame 0 has no label image in any camera"), std::string::npos) << r.err;
 }
 
 }  // namespace

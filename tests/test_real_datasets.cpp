@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "error_text.h"
+#include "mini_kitti.h"
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/io/image_io.h"
@@ -493,6 +494,18 @@ TEST(SemanticKitti, EveryMappedClassIsInTheDefaultTable) {
   EXPECT_TRUE(table.at(semanticKittiToClass(49)).ground);  // other-ground stays ground
 }
 
+// The map is documented as a table (docs/class-maps.md); the page must say what the reader does.
+TEST(SemanticKitti, ClassMapsPageListsTheReadersTable) {
+  const std::string page = readText(fs::path(SEMSEGMAP_SOURCE_DIR) / "docs" / "class-maps.md");
+  ASSERT_FALSE(page.empty());
+  const ClassTable table = ClassTable::Default();
+  for (const auto& row : semanticKittiClasses()) {
+    const std::string line = "| " + std::to_string(row.label) + " | " + row.name + " | " +
+                             table.at(row.class_id).name + " |";
+    EXPECT_NE(page.find(line), std::string::npos) << line;
+  }
+}
+
 TEST(SemanticKitti, LabelsAndPosesAreOptional) {
   TempDir tmp;
   const SemanticKittiFixture fx = writeSemanticKitti(tmp.path() / "08");
@@ -582,6 +595,166 @@ TEST(SemanticKitti, ErrorsNameTheFile) {
   const std::string msg = errorOf([&] { reader.frame(0); });
   EXPECT_MENTIONS(msg, "000000.bin");
   EXPECT_MENTIONS(msg, "point 1");
+}
+
+// With image_2: P2 = K [I | K^-1 p], the stereo offset t = K^-1 p = (0.06, -0.01, 0.004) m, on a
+// Tr without rotation noise, and 40x30 pictures.
+constexpr double kFx = 700, kCx = 20, kCy = 15;
+const Eigen::Vector3d kOffset(0.06, -0.01, 0.004);
+
+Pose cleanTr() {
+  Pose Tr = Pose::Identity();
+  Tr.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  Tr.translation() = Eigen::Vector3d(0, -0.08, -0.27);
+  return Tr;
+}
+
+Eigen::Matrix<double, 3, 4> p2Matrix() {
+  Eigen::Matrix3d K;
+  K << kFx, 0, kCx, 0, kFx, kCy, 0, 0, 1;
+  Eigen::Matrix<double, 3, 4> P;
+  P << K, K * kOffset;
+  return P;
+}
+
+std::string p2Line() {
+  std::string s = "P2:";
+  char buf[40];
+  const Eigen::Matrix<double, 3, 4> P = p2Matrix();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) {
+      std::snprintf(buf, sizeof(buf), " %.17g", P(r, c));
+      s += buf;
+    }
+  return s;
+}
+
+// The fixture with image_2 pictures (one grey level per frame) and that calibration.
+SemanticKittiFixture writeSemanticKittiWithImages(const fs::path& dir) {
+  SemanticKittiFixture fx = writeSemanticKitti(dir);
+  fx.Tr = cleanTr();
+  const std::string P0 = "700 0 20 0 0 700 15 0 0 0 1 0";
+  writeText(dir / "calib.txt", "P0: " + P0 + "\nP1: " + P0 + "\n" + p2Line() + "\nP3: " + P0 +
+                                   "\nTr: " + row3x4(fx.Tr) + "\n");
+  fs::create_directories(dir / "image_2");
+  for (int k = 0; k < 3; ++k)
+    writePng(dir / "image_2" / ("00000" + std::to_string(k) + ".png"),
+             Image(40, 30, 3, static_cast<uint8_t>(50 * k)));
+  return fx;
+}
+
+TEST(SemanticKitti, Image2IsACameraProjectingAsP2TimesTr) {
+  TempDir tmp;
+  const SemanticKittiFixture fx = writeSemanticKittiWithImages(tmp.path() / "05");
+  SemanticKittiReader reader(fx.dir);
+  ASSERT_EQ(reader.info().rig.cameras.size(), 1u);
+  const Camera& cam = reader.info().rig.cameras[0];
+  EXPECT_EQ(cam.name, "image_2");
+  EXPECT_EQ(cam.width, 40);
+  EXPECT_EQ(cam.height, 30);
+  // A point 20.27 m ahead of the Velodyne, 8 cm below it, is 20 m ahead of camera 0 on its axis
+  // (Tr), and (0.06, -0.01, 20.004) in camera 2: pixel (20 + 700 * 0.06 / 20.004,
+  // 15 - 700 * 0.01 / 20.004).
+  const auto uv = cam.project(cam.T_camera_lidar * Eigen::Vector3d(20.27, 0, -0.08));
+  ASSERT_TRUE(uv.has_value());
+  EXPECT_NEAR(uv->x(), 20 + 42.0 / 20.004, 1e-9);
+  EXPECT_NEAR(uv->y(), 15 - 7.0 / 20.004, 1e-9);
+  // Any point: the devkit's P2 * Tr * X.
+  for (const Eigen::Vector3d& X :
+       {Eigen::Vector3d(5, 1, 0.5), Eigen::Vector3d(30, -4, -1.5), Eigen::Vector3d(2, 0.3, 0.2)}) {
+    const Eigen::Vector3d h = p2Matrix() * (fx.Tr * X).homogeneous();
+    const auto got = cam.project(cam.T_camera_lidar * X);
+    ASSERT_TRUE(got.has_value());
+    EXPECT_NEAR(got->x(), h.x() / h.z(), 1e-9);
+    EXPECT_NEAR(got->y(), h.y() / h.z(), 1e-9);
+  }
+  const Frame f = reader.frame(2);
+  ASSERT_EQ(f.cameras.size(), 1u);
+  EXPECT_EQ(f.cameras[0].rgb.width, 40);
+  EXPECT_EQ(f.cameras[0].rgb.channels, 3);
+  EXPECT_EQ(f.cameras[0].rgb.at(3, 4)[1], 100);  // frame 2's picture, not another's
+  EXPECT_TRUE(f.cameras[0].label.empty());       // classes come from a network or a label set
+  EXPECT_EQ(f.point_labels.size(), f.points.size());
+}
+
+TEST(SemanticKitti, Image2ErrorsNameTheFile) {
+  TempDir tmp;
+  const SemanticKittiFixture fx = writeSemanticKittiWithImages(tmp.path() / "05");
+  fs::remove(fx.dir / "image_2" / "000001.png");
+  std::string msg = errorOf([&] { SemanticKittiReader r(fx.dir); });
+  EXPECT_MENTIONS(msg, (fx.dir / "image_2" / "000001.png").string() + ": missing");
+  EXPECT_ONE_LINE(msg);
+
+  writeSemanticKittiWithImages(fx.dir);
+  writePng(fx.dir / "image_2" / "000001.png", Image(41, 30, 3, 0));
+  SemanticKittiReader reader(fx.dir);
+  msg = errorOf([&] { reader.frame(1); });
+  EXPECT_MENTIONS(msg, (fx.dir / "image_2" / "000001.png").string() + ": picture is 41x30");
+  EXPECT_MENTIONS(msg, "000000.png is 40x30");
+  EXPECT_ONE_LINE(msg);
+
+  writeSemanticKittiWithImages(fx.dir);
+  replaceCalibLine(fx.dir / "calib.txt", "P2", "");
+  msg = errorOf([&] { SemanticKittiReader r(fx.dir); });
+  EXPECT_MENTIONS(msg, (fx.dir / "calib.txt").string() + ": P2: missing");
+  EXPECT_ONE_LINE(msg);
+
+  // Without poses the calibration is still needed for the camera.
+  writeSemanticKittiWithImages(fx.dir);
+  fs::remove(fx.dir / "poses.txt");
+  replaceCalibLine(fx.dir / "calib.txt", "Tr", "");
+  msg = errorOf([&] { SemanticKittiReader r(fx.dir); });
+  EXPECT_MENTIONS(msg, (fx.dir / "calib.txt").string() + ": Tr: missing");
+  EXPECT_ONE_LINE(msg);
+  fs::remove(fx.dir / "calib.txt");
+  msg = errorOf([&] { SemanticKittiReader r(fx.dir); });
+  EXPECT_MENTIONS(msg, (fx.dir / "calib.txt").string() + ": cannot open");
+  EXPECT_ONE_LINE(msg);
+}
+
+// The real sample: SemanticKITTI's labels say what each point is; where the points land must
+// agree with the picture.
+TEST(MiniKitti, PointsLandOnTheirPixels) {
+  SEMSEGMAP_SKIP_WITHOUT_MINI_KITTI();
+  TempDir tmp;
+  for (const std::string sequence : {"05", "07"}) {
+    SemanticKittiReader reader(test_support::miniKittiSequence(tmp.path(), sequence));
+    ASSERT_EQ(reader.size(), 10u);
+    const Camera& cam = reader.info().rig.cameras.at(0);
+    EXPECT_EQ(cam.width, 1226);
+    EXPECT_EQ(cam.height, 370);
+    const Frame f = reader.frame(0);
+    const Image& rgb = f.cameras.at(0).rgb;
+    size_t in_image = 0, road = 0, road_grey = 0, near_road = 0, far_road = 0;
+    double near_road_v = 0, far_road_v = 0;
+    for (size_t i = 0; i < f.points.size(); ++i) {
+      const LidarPoint& p = f.points[i];
+      const Eigen::Vector3d pc = cam.T_camera_lidar * Eigen::Vector3d(p.x, p.y, p.z);
+      const auto uv = cam.project(pc);
+      if (!uv || !cam.inImage(*uv)) continue;
+      ++in_image;
+      if (f.point_labels[i].class_id != cls::kRoad) continue;
+      ++road;
+      const uint8_t* c = rgb.at(static_cast<int>(uv->x()), static_cast<int>(uv->y()));
+      if (std::max({c[0], c[1], c[2]}) - std::min({c[0], c[1], c[2]}) < 40) ++road_grey;
+      // Depth order: the road nearer the car lies lower in the picture.
+      if (pc.z() < 10) near_road_v += uv->y(), ++near_road;
+      if (pc.z() > 20) far_road_v += uv->y(), ++far_road;
+    }
+    const double share = static_cast<double>(in_image) / f.points.size();
+    RecordProperty("in_image_share_" + sequence, std::to_string(share));
+    RecordProperty("road_grey_share_" + sequence, std::to_string(double(road_grey) / road));
+    // The picture spans 82 of the scan's 360 degrees of azimuth, and of the HDL-64E's rings (+2
+    // to -24.8 degrees) those down to -14.7: about a sixth of the scan (0.163 in both).
+    EXPECT_GT(share, 0.13) << sequence;
+    EXPECT_LT(share, 0.20) << sequence;
+    ASSERT_GT(road, 1000u) << sequence;
+    EXPECT_GT(static_cast<double>(road_grey) / road, 0.9) << sequence;  // asphalt is grey
+    ASSERT_GT(near_road, 100u);
+    ASSERT_GT(far_road, 100u);
+    EXPECT_GT(near_road_v / near_road, far_road_v / far_road + 40) << sequence;
+    EXPECT_GT(far_road_v / far_road, cam.cy) << sequence;  // the road is below the horizon
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

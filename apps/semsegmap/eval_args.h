@@ -16,8 +16,10 @@ std::vector<std::string> splitList(const std::string& s);
 std::vector<NamedConfig> comparedConfigs(const CliArgs& a);
 
 // The experiments on the simulator (eval segmentation, descriptors, localization, paper): only
-// in a build with it (cmd_eval.cpp). `eval revisits` runs on any recording (cmd_eval_revisits).
+// in a build with it (cmd_eval.cpp). `eval revisits` runs on any recording (cmd_eval_revisits),
+// `eval semantics` on any dataset with cameras and per-point ground truth (cmd_eval_semantics).
 const std::vector<const CommandSpec*>& simulatedEvalCommands();
 const CommandSpec& evalRevisitsCommand();
+const CommandSpec& evalSemanticsCommand();
 
 }  // namespace semsegmap::app

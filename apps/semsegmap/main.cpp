@@ -43,7 +43,8 @@ const std::vector<const CommandSpec*>& commands() {
   return all;
 }
 
-// The experiments: those on the simulator when the build has it, and `eval revisits` always.
+// The experiments: those on the simulator when the build has it, and `eval revisits` and
+// `eval semantics` always.
 const std::vector<const CommandSpec*>& evalCommands() {
   static const std::vector<const CommandSpec*> all = [] {
     std::vector<const CommandSpec*> e;
@@ -51,7 +52,8 @@ const std::vector<const CommandSpec*>& evalCommands() {
     e = simulatedEvalCommands();
 #endif
     // Before `eval paper`, which runs the others.
-    e.insert(e.end() - (e.empty() ? 0 : 1), &evalRevisitsCommand());
+    const std::ptrdiff_t before_paper = e.empty() ? 0 : 1;
+    e.insert(e.end() - before_paper, {&evalRevisitsCommand(), &evalSemanticsCommand()});
     return e;
   }();
   return all;

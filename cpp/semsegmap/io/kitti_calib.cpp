@@ -154,45 +154,51 @@ std::vector<std::pair<size_t, std::filesystem::path>> listKittiFrames(
   return files;
 }
 
-Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam, const KittiCalibFile& velo_to_cam,
-                            int index) {
-  const std::string suffix = "_0" + std::to_string(index);
-  const std::string p_key = "P_rect" + suffix;
-  const std::string s_key = "S_rect" + suffix;
-  const Eigen::MatrixXd P = cam_to_cam.matrix(p_key, 3, 4);
+Camera kittiProjectionCamera(const KittiCalibFile& calib, const std::string& p_key, int width,
+                             int height) {
+  const Eigen::MatrixXd P = calib.matrix(p_key, 3, 4);
   // Our pinhole model has no skew and a unit third row; anything else cannot be represented
   // exactly, and an approximate camera would silently misplace colors on the points.
   const double eps = 1e-9;
   if (std::abs(P(0, 1)) > eps || std::abs(P(1, 0)) > eps || std::abs(P(2, 0)) > eps ||
       std::abs(P(2, 1)) > eps || std::abs(P(2, 2) - 1.0) > eps)
-    throw std::runtime_error(cam_to_cam.path().string() + ": " + p_key +
+    throw std::runtime_error(calib.path().string() + ": " + p_key +
                              ": first three columns are not [fx 0 cx; 0 fy cy; 0 0 1]");
   if (!(P(0, 0) > 0 && P(1, 1) > 0))
-    throw std::runtime_error(cam_to_cam.path().string() + ": " + p_key +
+    throw std::runtime_error(calib.path().string() + ": " + p_key +
                              ": focal lengths must be positive");
+  Camera cam;
+  cam.width = width;
+  cam.height = height;
+  cam.fx = P(0, 0);
+  cam.fy = P(1, 1);
+  cam.cx = P(0, 2);
+  cam.cy = P(1, 2);
+  // P = K [I | K^-1 p]: the fourth column is K times where the reference camera's origin lies
+  // in this camera's frame (the stereo baseline), so it is a translation, not an intrinsic.
+  const Eigen::Matrix3d K = P.leftCols<3>();
+  cam.T_camera_lidar = Pose::Identity();
+  cam.T_camera_lidar.translation() = K.inverse() * P.col(3);
+  return cam;
+}
 
+Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam, const KittiCalibFile& velo_to_cam,
+                            int index) {
+  const std::string suffix = "_0" + std::to_string(index);
+  const std::string s_key = "S_rect" + suffix;
   const std::vector<double> size = cam_to_cam.numbers(s_key, 2);
   for (double v : size)
     if (!(v >= 1 && v < 1e5 && v == std::round(v)))
       throw std::runtime_error(cam_to_cam.path().string() + ": " + s_key +
                                ": expected a positive integer width and height");
 
-  Camera cam;
+  Camera cam = kittiProjectionCamera(cam_to_cam, "P_rect" + suffix, static_cast<int>(size[0]),
+                                     static_cast<int>(size[1]));
   cam.name = "image" + suffix;
-  cam.width = static_cast<int>(size[0]);
-  cam.height = static_cast<int>(size[1]);
-  cam.fx = P(0, 0);
-  cam.fy = P(1, 1);
-  cam.cx = P(0, 2);
-  cam.cy = P(1, 2);
-
-  const Eigen::Matrix3d K = P.leftCols<3>();
-  Pose rect_offset = Pose::Identity();
-  rect_offset.translation() = K.inverse() * P.col(3);
   Pose R_rect = Pose::Identity();
   R_rect.linear() = cam_to_cam.rotation("R_rect_00");
   const Pose T_cam0_velo = velo_to_cam.transform("R", "T");
-  cam.T_camera_lidar = rect_offset * R_rect * T_cam0_velo;
+  cam.T_camera_lidar = cam.T_camera_lidar * R_rect * T_cam0_velo;
   return cam;
 }
 

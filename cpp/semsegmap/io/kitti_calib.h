@@ -87,6 +87,15 @@ std::vector<Pose> readKittiPoses(const std::filesystem::path& path);
 // LiDAR poses in the first LiDAR frame: T_world_lidar = Tr^-1 * T_world_cam0 * Tr.
 std::vector<Pose> kittiLidarPoses(const std::vector<Pose>& camera0_poses, const Pose& Tr);
 
+// The camera of KITTI projection matrix `p_key` (3 x 4, "P2" of an odometry calib.txt) as our
+// pinhole camera of width x height, such that camera.project(camera.T_camera_lidar * X) equals
+// P * X for every point X in the reference camera's frame: P = K [I | K^-1 p] is split into the
+// intrinsics K and T_camera_lidar = Translation(K^-1 p). Callers compose T_camera_lidar with the
+// reference camera's extrinsic. Throws naming the file and key when P has skew, a third row
+// other than [0 0 1 *] or a non-positive focal length.
+Camera kittiProjectionCamera(const KittiCalibFile& calib, const std::string& p_key, int width,
+                             int height);
+
 // KITTI raw's rectified camera `index` (2 = left color) as our Camera, such that
 // camera.project(camera.T_camera_lidar * X) equals the devkit's
 // P_rect_0i * R_rect_00 * [R|T]_velo_to_cam * X for every LiDAR point X. P_rect_0i = K [I | K^-1 p]

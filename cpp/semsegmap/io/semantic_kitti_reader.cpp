@@ -7,6 +7,7 @@
 #include <string>
 
 #include "semsegmap/io/dataset_format.h"
+#include "semsegmap/io/image_io.h"
 #include "semsegmap/io/kitti_calib.h"
 
 namespace semsegmap {
@@ -51,6 +52,23 @@ const std::vector<SemanticKittiClass>& semanticKittiClasses() {
   return table;
 }
 
+namespace {
+
+std::string sizeText(const Image& im) {
+  return std::to_string(im.width) + "x" + std::to_string(im.height);
+}
+
+// image_2's camera: P2's pinhole after Tr, sized by the first picture (calib.txt has no size).
+Camera image2Camera(const KittiCalibFile& calib, const fs::path& first_picture) {
+  const Image first = readColorImage(first_picture);
+  Camera cam = kittiProjectionCamera(calib, "P2", first.width, first.height);
+  cam.name = "image_2";
+  cam.T_camera_lidar = cam.T_camera_lidar * calib.transform3x4("Tr");
+  return cam;
+}
+
+}  // namespace
+
 ClassId semanticKittiToClass(uint16_t label) {
   // A dense lookup over the id range SemanticKITTI uses; this runs for every point.
   static const std::array<ClassId, 260> lookup = [] {
@@ -89,10 +107,18 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
     poses = kittiLidarPoses(readKittiPoses(poses_path), Tr);
   }
 
+  const fs::path image_dir = dir_ / "image_2";
+  const bool has_images = fs::is_directory(image_dir);
   for (const auto& [number, scan] : scans) {
     FrameFiles f;
     f.scan = scan;
     f.number = number;
+    if (has_images) {
+      f.image = image_dir / (scan.stem().string() + ".png");
+      if (!fs::is_regular_file(f.image))
+        throw std::runtime_error(f.image.string() + ": missing (the picture of scan " +
+                                 scan.string() + ")");
+    }
     if (has_labels) {
       f.labels = label_dir / (scan.stem().string() + ".label");
       if (!fs::is_regular_file(f.labels))
@@ -115,6 +141,15 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
   info_.rig.lidar = velodyneHdl64e();
   info_.rig.T_base_lidar = Pose::Identity();  // as in KITTI raw, the base is the Velodyne
   info_.rig.rate_hz = 10.0;
+  if (has_images) {
+    size_image_ = frames_.front().image;
+    info_.rig.cameras = {image2Camera(KittiCalibFile(dir_ / "calib.txt"), size_image_)};
+    try {
+      info_.rig.validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error((dir_ / "calib.txt").string() + ": " + e.what());
+    }
+  }
   info_.classes = ClassTable::Default();
   info_.has_ground_truth_poses = has_poses;
   info_.has_odometry = has_poses;  // the poses serve as odometry too
@@ -134,6 +169,15 @@ Frame SemanticKittiReader::frame(size_t index) {
           files.labels.string() + ": " + std::to_string(f.point_labels.size()) + " labels but " +
           files.scan.string() + " has " + std::to_string(f.points.size()) + " points");
     for (PointLabel& l : f.point_labels) l.class_id = semanticKittiToClass(l.class_id);
+  }
+  if (!files.image.empty()) {
+    Image rgb = readColorImage(files.image);
+    const Camera& cam = info_.rig.cameras.front();
+    if (rgb.width != cam.width || rgb.height != cam.height)
+      throw std::runtime_error(files.image.string() + ": picture is " + sizeText(rgb) + " but " +
+                               size_image_.string() + " is " + std::to_string(cam.width) + "x" +
+                               std::to_string(cam.height) + " (image_2 has one size)");
+    f.cameras.push_back(CameraFrame{std::move(rgb), Image()});
   }
   if (files.T_world_lidar) {
     f.T_world_base = *files.T_world_lidar;
