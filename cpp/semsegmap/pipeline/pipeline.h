@@ -39,8 +39,8 @@ struct DescribedSegment {
 
 struct FrameResult {
   size_t frame_index = 0;
-  Pose T_local_base = Pose::Identity();  // the pose the local map is built with: its frame is
-                                         // the world (ground-truth poses) or odometry
+  Pose T_local_base = Pose::Identity();   // the pose the local map is built with: its frame is
+                                          // the world (ground-truth poses) or odometry
   size_t points = 0, colored_points = 0;  // unobserved ones: map_update.points_unobserved
   LocalMapUpdate map_update;
   SegmentationUpdate segmentation;
