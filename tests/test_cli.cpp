@@ -1150,6 +1150,36 @@ TEST(CliEvalSemantics, LabelsThenEvalOnTheRealMiniKitti) {
   EXPECT_NE(r.err.find("frame 0 has no label image in any camera"), std::string::npos) << r.err;
 }
 
+// The commonest real rig as a user runs it: one front camera on a 360-degree HDL-64E (the real
+// KITTI raw sample), labelled by a real network, mapped and localized with the real-data config
+// and LiDAR odometry. Three quarters of each scan is unobserved and stays as geometry.
+TEST(CliRealRig, AFrontCameraOnA360DegreeLidarMapsAndLocalizesWithANetworksLabels) {
+  const std::filesystem::path sample = std::filesystem::path(SEMSEGMAP_SHARED_DATA) /
+                                       "kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
+  if (!std::filesystem::exists(sample)) GTEST_SKIP() << "the real KITTI raw sample is absent";
+  if (!std::filesystem::exists(test_support::kEspNet))
+    GTEST_SKIP() << "no ESPNetv2 network (" << test_support::kEspNet.string() << ")";
+  TempDir tmp;
+  const std::filesystem::path net = test_support::writeEspNetConfig(tmp.path(), "config");
+  const std::string scans = " --dataset kitti-raw:" + sample.string();
+  const std::string dataset = scans + " --odometry lidar";
+  const std::string labels = (tmp.path() / "labels").string(),
+                    map = (tmp.path() / "k.map").string();
+  Result r = run("label" + scans + " --config " + net.string() + " --out " + labels);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("map" + dataset + " --labels " + labels + " --config config/lidar-camera.yaml --out " +
+          map);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;  // a quarter is enough coverage
+  const size_t at = r.out.find("frames 10  segments ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_GE(std::stoul(r.out.substr(at + 20)), 25u) << r.out;  // not 3, as when dropped
+  r = run("localize" + dataset + " --labels " + labels + " --config config/lidar-camera.yaml" +
+          " --map " + map + " --out " + (tmp.path() / "loc").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("frames 10  localizations 10"), std::string::npos) << r.out;
+}
+
 }  // namespace
 }  // namespace semsegmap
 

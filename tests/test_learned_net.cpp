@@ -242,6 +242,14 @@ TEST(NetInput, UnobservedPointsAreMissingFromTheClassHistograms) {
   // The box's far half (x > 1 of 2 m) fills the grid's last third of cells along x: empty.
   EXPECT_EQ(in.class_grid[0].narrow(1, 2, 1).sum().item<float>(), 0.0f);
   EXPECT_GT(in.class_grid[0].narrow(1, 0, 1).sum().item<float>(), 0.0f);
+  // Without any class (a LiDAR alone), every point is in the unknown bin, as a model that does
+  // not read classes sees it: the input the shipped models were measured on.
+  for (EnrichedPoint& p : car) p.has_class = false;
+  NetConfig no_classes = config;
+  no_classes.use_classes = false;
+  const NetInput grey = makeNetInput(config, {&car}, rng);
+  EXPECT_TRUE(torch::equal(grey.class_grid, makeNetInput(no_classes, {&car}, rng).class_grid));
+  EXPECT_GT(grey.class_grid[0][cls::kUnknown].sum().item<float>(), 0.0f);
 }
 
 TEST(NetInput, ShapesAndRanges) {

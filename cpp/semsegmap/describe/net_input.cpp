@@ -136,7 +136,14 @@ PointNetSample makePointNetSample(const EnrichedCloud& points, int num_points, i
     std::copy(color.begin(), color.end(), row + 3);
   }
 
-  // Class histograms over the bounding box; a flat axis puts everything in its middle cell.
+  // Class histograms over the bounding box; a flat axis puts everything in its middle cell. An
+  // observation in which some points have a class leaves its unobserved points out (missing,
+  // not a vote for unknown: a segment half in the picture gets the histogram of its seen half);
+  // one without any class is a sensor without a network, every point in the unknown bin, as the
+  // models were trained and measured on such input.
+  const bool skip_unobserved =
+      use_classes &&
+      std::any_of(points.begin(), points.end(), [](const EnrichedPoint& p) { return p.has_class; });
   std::vector<double> counts(static_cast<size_t>(num_classes) * 27, 0.0);
   std::array<double, 27> totals{};
   for (const EnrichedPoint& p : points) {
@@ -147,10 +154,10 @@ PointNetSample makePointNetSample(const EnrichedCloud& points, int num_points, i
       cell[a] = size > 0 ? cellOf(q[a], lo[a], size, 3) : 1;
     }
     const int flat = (cell[0] * 3 + cell[1]) * 3 + cell[2];
-    // An unobserved point is missing from its cell's histogram, not a vote for class unknown:
-    // a segment half in the picture gets the histogram of its seen half.
-    if (use_classes && !p.has_class) continue;
-    const int cls = use_classes ? std::min<int>(p.class_id, num_classes - 1) : cls::kUnknown;
+    if (skip_unobserved && !p.has_class) continue;
+    // A point without a class is in the unknown bin whatever id it carries.
+    const int cls =
+        use_classes && p.has_class ? std::min<int>(p.class_id, num_classes - 1) : cls::kUnknown;
     counts[static_cast<size_t>(cls) * 27 + flat] += 1.0;
     totals[flat] += 1.0;
   }
