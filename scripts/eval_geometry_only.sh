@@ -13,7 +13,7 @@ bin=${SEMSEGMAP:-$root/build/semsegmap}
 [ -f "$model" ] || { echo "$model: no such model file" >&2; exit 1; }
 mkdir -p "$out"
 config=$out/config.yaml
-sed -e "s|model: ../models/semsegmap-net.model.*|model: $root/models/semsegmap-net.model\n  model_lidar_only: $model|" \
+sed -e "s|  model: ../models/|  model: $root/models/|" -e "s|model_lidar_only: .*|model_lidar_only: $model|" \
   "$root/config/lidar-camera.yaml" > "$config"
 grep -q "model_lidar_only: $model" "$config" || { echo "$config: could not name the model" >&2; exit 1; }
 for lidar in "$@"; do
