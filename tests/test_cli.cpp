@@ -493,13 +493,8 @@ TEST(Cli, NoOdometryIsRefusedUpFrontNamingTheOptions) {
   }
 }
 
-// The segmentation network as a user runs it: `label` writes a label set once (with a preview to
-// look at), later commands read it with --labels; a config without a network, or a label set of
-// another dataset, is refused in one line before any frame.
-TEST(Cli, LabelWritesALabelSetThatLaterCommandsRead) {
-  if (!SEMSEGMAP_WITH_SIM) GTEST_SKIP() << "the pictures come from the simulator";
-  TempDir tmp;
-  const auto dir = tmp.path();
+// The segmentation network of the tests (tests' colour4.onnx) in a config, with its class map.
+std::string networkConfig(const std::filesystem::path& dir) {
   std::ofstream(dir / "colour.yaml")
       << "name: colour4\nclasses:\n  - {id: 0, name: red, class: building}\n"
          "  - {id: 1, name: green, class: vegetation}\n  - {id: 2, name: blue, class: sky}\n"
@@ -508,6 +503,17 @@ TEST(Cli, LabelWritesALabelSetThatLaterCommandsRead) {
                                      "/colour4.onnx\n"
                                      "  class_map: colour.yaml\n  mean: [0, 0, 0]\n"
                                      "  std: [1, 1, 1]\n  replace_dataset_labels: true\n";
+  return (dir / "net.yaml").string();
+}
+
+// The segmentation network as a user runs it: `label` writes a label set once (with a preview to
+// look at), later commands read it with --labels; a config without a network, or a label set of
+// another dataset, is refused in one line before any frame.
+TEST(Cli, LabelWritesALabelSetThatLaterCommandsRead) {
+  if (!SEMSEGMAP_WITH_SIM) GTEST_SKIP() << "the pictures come from the simulator";
+  TempDir tmp;
+  const auto dir = tmp.path();
+  networkConfig(dir);
   const std::string data = " --dataset sim:preset=tiny,frames=2";
   const Result r = run("label" + data + " --config " + (dir / "net.yaml").string() + " --out " +
                        (dir / "labels").string());
@@ -731,19 +737,6 @@ TEST(CliPoseFiles, MapAndLocalizeWithOdometryFilesInKittiAndTumFormat) {
   EXPECT_NE(few.err.find("short.txt: 2 KITTI poses, but the scans go up to frame 2"),
             std::string::npos)
       << few.err;
-}
-
-// The segmentation network of the tests (tests' colour4.onnx) in a config, with its class map.
-std::string networkConfig(const std::filesystem::path& dir) {
-  std::ofstream(dir / "colour.yaml")
-      << "name: colour4\nclasses:\n  - {id: 0, name: red, class: building}\n"
-         "  - {id: 1, name: green, class: vegetation}\n  - {id: 2, name: blue, class: sky}\n"
-         "  - {id: 3, name: dark, class: road}\n";
-  std::ofstream(dir / "net.yaml") << "semantics:\n  model: " SEMSEGMAP_ONNX_DIR
-                                     "/colour4.onnx\n"
-                                     "  class_map: colour.yaml\n  mean: [0, 0, 0]\n"
-                                     "  std: [1, 1, 1]\n  replace_dataset_labels: true\n";
-  return (dir / "net.yaml").string();
 }
 
 // `label --max-frames 1` records the one frame it labelled, and `map --labels` refuses the set
