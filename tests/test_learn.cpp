@@ -606,7 +606,11 @@ TEST_F(SimulatedData, DistillationPullsALidarOnlyStudentTowardsItsColourTeacher)
 TEST_F(SimulatedData, AStudentStartsFromItsTeachersWeights) {
   TrainConfig teaching = tinyTraining();
   teaching.epochs = 1;
+  // Training sets libtorch's thread count, the process's, for itself alone.
+  const int callers_threads = torch::get_num_threads();
+  teaching.threads = callers_threads == 1 ? 2 : 1;
   const std::shared_ptr<DescriptorNetImpl> teacher = trainDescriptor(*data_, teaching).net;
+  EXPECT_EQ(torch::get_num_threads(), callers_threads);
   TrainConfig student = tinyTraining();
   student.net.use_color = student.net.use_classes = false;
   student.epochs = 1;

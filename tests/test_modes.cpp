@@ -290,6 +290,22 @@ TEST(Modes, AMapOfAnOlderBuildReadsItsUnobservedRuleFromRemoveUnknownClass) {
   EXPECT_EQ(upgradeMapParameters(map.parameters), map.parameters);
 }
 
+// A session that describes segments refuses to start without a describer, naming itself.
+TEST(Modes, SessionsWithoutADescriberAreRefusedAtConstruction) {
+  DatasetInfo info;
+  info.has_odometry = info.has_ground_truth_poses = true;
+  info.classes = ClassTable::Default();
+  try {
+    MappingSession session(semsegmapConfig(), info, PoseSource::kGroundTruth, nullptr);
+    ADD_FAILURE() << "a mapping session without a describer was made";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "MappingSession: no describer given (makeDescriber)");
+  }
+  EXPECT_THROW(
+      LocalizationSession(semsegmapConfig(), info, std::make_shared<const TargetMap>(), nullptr),
+      std::invalid_argument);
+}
+
 TEST(Modes, LocalizationRefusesAMapOfAnotherModel) {
   SEMSEGMAP_SKIP_WITHOUT_SIM();
   const auto oracle = std::make_shared<OracleDescriber>();

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -51,5 +52,13 @@ struct DescriberOptions {
 // Throws std::invalid_argument for a learned kind without a network or with one of another kind,
 // std::runtime_error "<kind>: <descriptorNotBuilt>" for a kind this build does not have.
 std::unique_ptr<Describer> makeDescriber(DescriptorKind kind, const DescriberOptions& options);
+
+// What a session that describes segments needs: throws std::invalid_argument naming `who` when
+// it was given no describer, at construction instead of a null dereference later.
+inline const Describer& requireDescriber(const std::shared_ptr<Describer>& describer,
+                                         const std::string& who) {
+  if (!describer) throw std::invalid_argument(who + ": no describer given (makeDescriber)");
+  return *describer;
+}
 
 }  // namespace semsegmap

@@ -417,7 +417,12 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
                             std::shared_ptr<DescriptorNetImpl> teacher) {
   checkConfig(config);
   if (teacher) checkTeacher(config, *teacher);
-  torch::set_num_threads(config.threads);
+  // libtorch's thread count is the process's: given back when training ends, however it ends.
+  struct TorchThreads {
+    int saved = torch::get_num_threads();
+    explicit TorchThreads(int threads) { torch::set_num_threads(threads); }
+    ~TorchThreads() { torch::set_num_threads(saved); }
+  } threads(config.threads);
   torch::manual_seed(config.seed);
 
   TrainResult result;

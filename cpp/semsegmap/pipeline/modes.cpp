@@ -20,6 +20,13 @@ void feed(FrameSource& source, const RunOptions& options, Session& session) {
   }
 }
 
+// The describer is checked before any of it is read: a constructor's arguments are evaluated in
+// no fixed order.
+TargetMapBuilder builderFor(const Describer& describer, const TargetMapBuilderConfig& config) {
+  return TargetMapBuilder(descriptorName(describer.kind()), describer.fingerprint(),
+                          describer.dimension(), config);
+}
+
 MapSegment mapSegmentOf(const Segment& s, size_t points) {
   const SegmentObservation& o = s.last();
   MapSegment m;
@@ -39,8 +46,7 @@ MappingSession::MappingSession(const PipelineConfig& config, const DatasetInfo& 
                                PoseSource poses, std::shared_ptr<Describer> describer)
     : config_(config),
       pipeline_(config, info, poses, describer),
-      builder_(descriptorName(describer->kind()), describer->fingerprint(), describer->dimension(),
-               config.target_map) {
+      builder_(builderFor(requireDescriber(describer, "MappingSession"), config.target_map)) {
   builder_.setParameters(mapParametersOf(config));
 }
 
@@ -177,7 +183,8 @@ LocalizationSession::LocalizationSession(const PipelineConfig& config, const Dat
     : config_(config),
       info_(info),
       describer_(describer),
-      localizer_(checkedMap(std::move(map), *describer, config, settings),
+      localizer_(checkedMap(std::move(map), requireDescriber(describer, "LocalizationSession"),
+                            config, settings),
                  config.localization.localizer),
       pipeline_(config, info, PoseSource::kOdometry, describer) {
   run_.odometry_is_ground_truth = info.odometry_is_ground_truth;

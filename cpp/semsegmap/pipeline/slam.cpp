@@ -21,7 +21,8 @@ class SlamSession {
       : config_(config),
         graph_(config.loop_closure.graph),
         pipeline_(config, info, PoseSource::kOdometry, describer),
-        localizer_(emptyMap(*describer), config.localization.localizer) {
+        localizer_(emptyMap(requireDescriber(describer, "SlamSession")),
+                   config.localization.localizer) {
     run_.odometry_is_ground_truth = info.odometry_is_ground_truth;
   }
 

@@ -46,6 +46,24 @@ class QuietOpenCv {
   cv::utils::logging::LogLevel level_;
 };
 
+// OpenCV's thread count is the process's: set for the network's run only, then given back, so
+// that a caller's own setting (or another network's) is never changed behind its back.
+class OpenCvThreads {
+ public:
+  explicit OpenCvThreads(int threads) : saved_(cv::getNumThreads()), set_(threads > 0) {
+    if (set_) cv::setNumThreads(threads);
+  }
+  ~OpenCvThreads() {
+    if (set_) cv::setNumThreads(saved_);
+  }
+  OpenCvThreads(const OpenCvThreads&) = delete;
+  OpenCvThreads& operator=(const OpenCvThreads&) = delete;
+
+ private:
+  int saved_;
+  bool set_;
+};
+
 }  // namespace
 
 ResizePolicy parseResizePolicy(const std::string& name) {
@@ -83,7 +101,6 @@ SegmentationNetwork::SegmentationNetwork(const SemanticsConfig& config, const st
   if (impl_->net.empty()) throw std::runtime_error(model_name_ + ": the ONNX model has no layers");
   impl_->net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
   impl_->net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-  if (config_.threads > 0) cv::setNumThreads(config_.threads);
 }
 
 SegmentationNetwork::~SegmentationNetwork() = default;
@@ -150,6 +167,7 @@ cv::Mat runNetwork(cv::dnn::Net& net, const Image& rgb, const SemanticsConfig& c
   const cv::Mat blob = inputBlob(rgb, c, placement);
   try {
     QuietOpenCv quiet;
+    OpenCvThreads threads(c.threads);
     net.setInput(blob);
     return net.forward().clone();
   } catch (const cv::Exception& e) {

@@ -43,7 +43,7 @@ struct SemanticsConfig {
   std::array<float, 3> std{0.229f, 0.224f, 0.225f};
   bool bgr = false;  // the network takes BGR channels (Caffe and OpenCV-trained models)
   NetworkOutput output = NetworkOutput::kLogits;
-  int threads = 2;  // OpenCV's threads (process-wide)
+  int threads = 2;  // OpenCV's threads while the network runs (given back after each picture)
   // The network may run slower than the LiDAR: at most rate_hz per camera (0: every frame), each
   // scan in between taking the camera's latest labels when they are at most tolerance_s older.
   double rate_hz = 0.0;
