@@ -1,8 +1,8 @@
 // The camera segmentation network (the paper's first step: "the color images are passed through
 // a semantic segmentation network"): a network exported to ONNX, run on the CPU through OpenCV's
 // DNN module, turns an RGB picture into a label image in the project's classes through a class
-// map. No network is shipped (none can be downloaded here); docs/real-data.md "Semantics from a network"
-// says how to export one and which class map goes with it.
+// map. No network is shipped (none can be downloaded here); docs/real-data.md, "Semantics from a
+// network", says how to export one and which class map goes with it.
 #pragma once
 
 #include <array>
