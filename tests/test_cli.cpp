@@ -1149,6 +1149,7 @@ TEST(CliEvalSemantics, LabelsThenEvalOnTheRealMiniKitti) {
 TEST(CliRealRig, AFrontCameraOnA360DegreeLidarMapsAndLocalizesWithANetworksLabels) {
   const std::filesystem::path sample = std::filesystem::path(SEMSEGMAP_SHARED_DATA) /
                                        "kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
+  if (!SEMSEGMAP_WITH_TORCH) GTEST_SKIP() << "the real-data config's descriptor needs libtorch";
   if (!std::filesystem::exists(sample)) GTEST_SKIP() << "the real KITTI raw sample is absent";
   if (!std::filesystem::exists(test_support::kEspNet))
     GTEST_SKIP() << "no ESPNetv2 network (" << test_support::kEspNet.string() << ")";
