@@ -104,7 +104,8 @@ void trainingCacheSeeds(const fs::path& dir) {
     o.purity = 0.9f;
     o.xyzhsv = std::vector<float>(18, 0.25f);
     o.classes = {1, 2, 3};
-    o.colored = {1, 0, 1};
+    o.modalities = {TrainingObservation::kHasColor | TrainingObservation::kHasClass, 0,
+                    TrainingObservation::kHasColor};
     set.observations.push_back(o);
   }
   fs::create_directories(dir);
