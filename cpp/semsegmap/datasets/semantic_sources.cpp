@@ -82,10 +82,14 @@ namespace {
 void checkLabelSetFrames(const LabelSetInfo& set, const std::filesystem::path& dir,
                          size_t dataset_frames, size_t frames_needed) {
   const std::string yaml = (dir / "labels.yaml").string();
-  const size_t made_from = set.dataset_frames > 0 ? set.dataset_frames : set.frames;
-  if (set.dataset_frames > 0 ? made_from != dataset_frames : made_from > dataset_frames)
-    throw std::runtime_error(yaml + ": labels a dataset of " + std::to_string(made_from) +
-                             " frames, this one has " + std::to_string(dataset_frames));
+  // Older sets record no dataset_frames: they can only be checked to fit.
+  const bool other_dataset =
+      set.dataset_frames > 0 ? set.dataset_frames != dataset_frames : set.frames > dataset_frames;
+  if (other_dataset)
+    throw std::runtime_error(
+        yaml + ": labels a dataset of " +
+        std::to_string(set.dataset_frames > 0 ? set.dataset_frames : set.frames) +
+        " frames, this one has " + std::to_string(dataset_frames));
   if (set.frames < frames_needed)
     throw std::runtime_error(
         dir.string() + ": the label set labels frames 0 to " + std::to_string(set.frames - 1) +

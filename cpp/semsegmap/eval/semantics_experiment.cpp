@@ -137,11 +137,9 @@ SemanticsFrame scoreFrame(const Frame& frame, const std::vector<PointLabel>& tru
 void countSegments(const std::vector<Segment>& segments, SemanticsEvaluation& e) {
   for (const Segment& s : segments) {
     ++e.segments;
-    for (const EnrichedPoint& p : s.last().points)
-      if (p.has_class) {
-        ++e.segments_with_class;
-        break;
-      }
+    const EnrichedCloud& points = s.last().points;
+    e.segments_with_class += std::any_of(points.begin(), points.end(),
+                                         [](const EnrichedPoint& p) { return p.has_class; });
   }
 }
 
