@@ -19,11 +19,13 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "command_result.h"
+#include "doc_blocks.h"
 #include "mini_kitti.h"
 #include "temp_dir.h"
 
@@ -114,6 +116,7 @@ const std::vector<CommandOptions> kAllCommands = {
       "seed",
       "confused-sections",
       "modality-dropout",
+      "partial-coverage",
       "lidar-only",
       "teacher",
       "distillation-weight",
@@ -459,6 +462,12 @@ TEST(Cli, TrainChecksItsTeacherBeforeExtracting) {
   EXPECT_NE(dropout.err.find("the teacher would see the same dropped observation"),
             std::string::npos)
       << dropout.err;
+  const Result partial =
+      run(train + "--descriptor semsegmap-net --lidar-only --partial-coverage 0.5");
+  EXPECT_EQ(partial.code, 2);
+  EXPECT_NE(partial.err.find("--partial-coverage: a --lidar-only network sees neither"),
+            std::string::npos)
+      << partial.err;
   const Result missing =
       run(train + "--descriptor semsegmap-net --teacher " + (tmp.path() / "none.model").string());
   EXPECT_EQ(missing.code, 1);
@@ -1146,6 +1155,113 @@ TEST(CliEvalSemantics, LabelsThenEvalOnTheRealMiniKitti) {
 // The commonest real rig as a user runs it: one front camera on a 360-degree HDL-64E (the real
 // KITTI raw sample), labelled by a real network, mapped and localized with the real-data config
 // and LiDAR odometry. Three quarters of each scan is unobserved and stays as geometry.
+// A command line the documentation shows: where, the shell variables its block sets first
+// (`S=sim:...`), and the line itself with its `\` continuations joined.
+struct DocumentedCommand {
+  std::string where;
+  std::vector<std::pair<std::string, std::string>> variables;
+  std::string line;
+};
+
+// `$NAME` replaced by the value an earlier assignment of the block gave it.
+std::string expanded(std::string value,
+                     const std::vector<std::pair<std::string, std::string>>& variables) {
+  for (const auto& [name, v] : variables)
+    for (size_t at; (at = value.find("$" + name)) != std::string::npos;)
+      value.replace(at, name.size() + 1, v);
+  return value;
+}
+
+std::vector<DocumentedCommand> documentedCommands() {
+  std::vector<std::filesystem::path> files = {"README.md", "models/MODEL_CARD.md",
+                                              "fuzz/README.md"};
+  for (const auto& entry : std::filesystem::directory_iterator("docs"))
+    if (entry.path().extension() == ".md") files.push_back(entry.path());
+  const std::regex command("^build/semsegmap\\s+(.*)$"), assignment("([A-Z_]+)=(\\S*)");
+  std::vector<DocumentedCommand> found;
+  for (const auto& file : files) {
+    for (const std::vector<std::string>& block : test_support::codeBlocks(file)) {
+      std::vector<std::pair<std::string, std::string>> variables;
+      for (const std::string& l : block) {
+        std::smatch m;
+        if (std::regex_match(l, m, command)) {
+          // Without a trailing `# comment`, which would also swallow run()'s redirections.
+          found.push_back({file.string(), variables,
+                           std::regex_replace(m[1].str(), std::regex("\\s+#.*$"), "")});
+          continue;
+        }
+        // `S=...` or `S=...; G=$S,...`: a line of assignments alone.
+        if (!std::regex_match(l, std::regex("^([A-Z_]+=\\S*;?\\s*)+$"))) continue;
+        for (std::sregex_iterator a(l.begin(), l.end(), assignment), end; a != end; ++a) {
+          std::string value = (*a)[2].str();
+          if (!value.empty() && value.back() == ';') value.pop_back();
+          variables.emplace_back((*a)[1].str(), expanded(value, variables));
+        }
+      }
+    }
+  }
+  return found;
+}
+
+// Every `build/semsegmap ...` line of the README, docs/, the model card and fuzz/README.md
+// parses as its command would (`semsegmap --check-usage`): a renamed option or a placeholder
+// read as a list of choices breaks this test, not a user's first try.
+TEST(Docs, EveryCommandLineTheDocumentationShowsParses) {
+  const std::vector<DocumentedCommand> commands = documentedCommands();
+  ASSERT_GE(commands.size(), 40u) << "the README and docs show that many";
+  size_t checked = 0;
+  for (const DocumentedCommand& c : commands) {
+    SCOPED_TRACE(c.where + ": build/semsegmap " + c.line);
+    for (const auto& [name, value] : c.variables) ::setenv(name.c_str(), value.c_str(), 1);
+    const Result r = run("--check-usage " + c.line);
+    // This build may leave a command out (the SEMSEGMAP_WITH_* options): it says so.
+    if (r.code == 1 && r.err.find("this build has no") != std::string::npos) continue;
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("usage ok"), std::string::npos) << r.out;
+    ++checked;
+  }
+  EXPECT_GE(checked, SEMSEGMAP_WITH_SIM && SEMSEGMAP_WITH_TORCH ? commands.size() : 10u);
+}
+
+TEST(Docs, CheckUsageRefusesWhatTheCommandWouldAndRunsNothing) {
+  Result r = run("--check-usage map --dataset folder:nowhere --out x.map --bogus 1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--bogus"), std::string::npos) << r.err;
+  TempDir tmp;
+  const std::filesystem::path out = tmp.path() / "never.map";
+  r = run("--check-usage map --dataset folder:nowhere --config nowhere.yaml --out " + out.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out)) << "nothing runs, nothing is written";
+}
+
+// docs/real-data.md's PJLab example run as the page shows it, in a folder where `pjlab/` is the
+// real sample and `examples/` the repository's: the overlay is written at the width asked.
+TEST(Docs, ThePjlabEnrichExampleRunsAsShown) {
+  const std::filesystem::path sample =
+      std::filesystem::path(SEMSEGMAP_SHARED_DATA) / "pjlab_lidar_camera_sample";
+  if (!std::filesystem::exists(sample)) GTEST_SKIP() << "the real PJLab sample is absent";
+  if (!SEMSEGMAP_WITH_PCL)
+    GTEST_SKIP() << "PCD files are read with PCL, which this build leaves out";
+  TempDir tmp;
+  std::filesystem::create_directory_symlink(sample, tmp.path() / "pjlab");
+  std::filesystem::create_directory_symlink(std::filesystem::absolute("examples"),
+                                            tmp.path() / "examples");
+  size_t ran = 0;
+  for (std::string line : test_support::blockContaining("docs/real-data.md", "folder:pjlab")) {
+    if (line.rfind("build/semsegmap ", 0) != 0) continue;
+    const Result r = run("--version > /dev/null && cd '" + tmp.path().string() + "' && '" +
+                         std::filesystem::absolute(g_binary).string() + "' " + line.substr(16));
+    ASSERT_EQ(r.code, 0) << line << "\n" << r.err;
+    ++ran;
+  }
+  ASSERT_EQ(ran, 1u);
+  const std::string png = readFile(tmp.path() / "pjlab_overlay.png");
+  ASSERT_GT(png.size(), 24u) << "no overlay written";
+  // The PNG header's width, big-endian at byte 16.
+  const auto byte = [&](size_t i) { return static_cast<uint32_t>(static_cast<uint8_t>(png[i])); };
+  EXPECT_EQ(byte(16) << 24 | byte(17) << 16 | byte(18) << 8 | byte(19), 720u);
+}
+
 TEST(CliRealRig, AFrontCameraOnA360DegreeLidarMapsAndLocalizesWithANetworksLabels) {
   const std::filesystem::path sample = std::filesystem::path(SEMSEGMAP_SHARED_DATA) /
                                        "kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";

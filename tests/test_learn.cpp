@@ -244,6 +244,50 @@ TEST(Augment, ModalityDropoutTakesAllColourOrAllClassesOfAnObservation) {
   EXPECT_EQ(geometry[7].v, 0.0f) << "grey, as the network input of a point without colour";
 }
 
+TEST(Augment, PartialCoverageUnobservesThePointsBeyondAVerticalPlane) {
+  const EnrichedCloud cloud = randomCloud(2000, 11);
+  std::mt19937 rng(11);
+  const EnrichedCloud out = unobserveSection(cloud, 0.4, rng);
+  ASSERT_EQ(out.size(), cloud.size()) << "unobserved, not removed";
+  std::vector<Eigen::Vector2f> seen, unseen;
+  for (size_t i = 0; i < out.size(); ++i) {
+    EXPECT_EQ(out[i].x, cloud[i].x);
+    ASSERT_EQ(out[i].has_color, out[i].has_class) << "a camera gives both or neither";
+    (out[i].has_class ? seen : unseen).emplace_back(out[i].x, out[i].y);
+  }
+  EXPECT_NEAR(static_cast<double>(unseen.size()), 800.0, 2.0);
+  // A vertical plane: some horizontal direction separates the two sets whatever the heights.
+  bool separated = false;
+  for (int k = 0; k < 3600 && !separated; ++k) {
+    const Eigen::Vector2f n(std::cos(k * 0.1f * 3.14159265f / 180.0f),
+                            std::sin(k * 0.1f * 3.14159265f / 180.0f));
+    float max_seen = -1e9f, min_unseen = 1e9f;
+    for (const auto& p : seen) max_seen = std::max(max_seen, n.dot(p));
+    for (const auto& p : unseen) min_unseen = std::min(min_unseen, n.dot(p));
+    separated = max_seen <= min_unseen + 1e-4f;
+  }
+  EXPECT_TRUE(separated) << "the unobserved points lie beyond one vertical plane";
+  for (const EnrichedPoint& p : out) {
+    if (!p.has_class) {
+      EXPECT_EQ(p.class_id, cls::kUnknown);
+    }
+  }
+}
+
+TEST(Augment, PartialCoverageOffKeepsTheRecipeBeforeIt) {
+  AugmentConfig with;
+  with.partial_coverage_probability = 1.0;
+  const auto [off, on] = augmentedOffAndOn(with, 12);
+  ASSERT_EQ(off.size(), on.size());
+  size_t unobserved = 0;
+  for (size_t i = 0; i < off.size(); ++i) {
+    EXPECT_EQ(off[i].x, on[i].x) << "the same draws up to the partial coverage";
+    unobserved += !on[i].has_class;
+  }
+  EXPECT_GT(unobserved, 0u);
+  EXPECT_LT(unobserved, off.size());
+}
+
 TEST(Augment, ModalityDropoutOffKeepsTheRecipeBeforeIt) {
   AugmentConfig with;
   with.modality_dropout_probability = 1.0;

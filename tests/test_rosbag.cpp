@@ -27,6 +27,7 @@
 #include <tf2_msgs/TFMessage.h>
 #endif
 
+#include "doc_blocks.h"
 #include "error_text.h"
 #include "fuzz_regressions.h"
 #include "semsegmap/core/atomic_file.h"
@@ -1181,6 +1182,71 @@ TEST_P(Bags, RealKittiSampleRoundTrip) {
     }
     EXPECT_EQ(b.cameras.at(0).rgb, a.cameras.at(0).rgb);
   }
+}
+
+// The README's worked example, bag in, map out, another drive localized against it, run line
+// by line as the README shows it (`build/semsegmap` is this build's binary) in a folder that
+// holds monday.bag and tuesday.bag (the real KITTI raw sample with its oxts as /odom) and a copy
+// of config/: the copied config must still find the shipped models.
+TEST(ReadmeBagExample, RunsAsTheReadmeShowsIt) {
+  if (!SEMSEGMAP_WITH_ROS1)
+    GTEST_SKIP() << "this build reads no ROS 1 bags (SEMSEGMAP_WITH_ROS1=OFF)";
+  if (!SEMSEGMAP_WITH_TORCH) GTEST_SKIP() << "config/lidar-camera.yaml's descriptor needs libtorch";
+  if (!fs::exists(kKittiDrive))
+    GTEST_SKIP() << "the real KITTI sample is absent (" << kKittiDrive.string() << ")";
+  // The sample has no oxts: its odometry is the project's LiDAR odometry, as a robot's would be.
+  TempDir dir;
+  const std::string odometry = "'" + std::string(SEMSEGMAP_BINARY) +
+                               "' odometry --dataset kitti-raw:" + kKittiDrive.string() +
+                               " --out '" + (dir.path() / "odo").string() + "' > /dev/null 2>&1";
+  ASSERT_EQ(std::system(odometry.c_str()), 0) << odometry;
+  std::ifstream poses(dir.path() / "odo" / "trajectory_kitti.txt");
+  semsegmap::KittiRawReader kitti(kKittiDrive);
+  std::vector<BagMessage> messages = kittiMessages(kitti, kitti.size());
+  const Pose T_base_lidar = kitti.info().rig.T_base_lidar;
+  for (size_t i = 0; i < kitti.size(); ++i) {
+    Pose T_odom_base = Pose::Identity();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) poses >> T_odom_base.matrix()(r, c);
+    ASSERT_TRUE(poses) << "line " << i << " of the odometry";
+    const double t = kEpoch + kitti.frame(i).timestamp_s;
+    messages.push_back(
+        {"/odom", t,
+         rm::Odometry{{t, "odom"}, "velo_link", transformOf(T_odom_base * T_base_lidar)}});
+  }
+#if SEMSEGMAP_WITH_ROS1
+  writeRos1(dir.path() / "monday.bag", messages);
+  writeRos1(dir.path() / "tuesday.bag", messages);
+#endif
+  fs::create_directories(dir.path() / "config");
+  for (const auto& entry : fs::directory_iterator(fs::path(SEMSEGMAP_SOURCE_DIR) / "config"))
+    if (entry.path().extension() == ".yaml")
+      fs::copy_file(entry.path(), dir.path() / "config" / entry.path().filename());
+  const std::vector<std::string> block = semsegmap::test_support::blockContaining(
+      fs::path(SEMSEGMAP_SOURCE_DIR) / "README.md", "rosbag:tuesday.bag");
+  size_t ran = 0;
+  for (std::string line : block) {
+    if (line.rfind("build/semsegmap ", 0) != 0) continue;
+    line.replace(0, 15, std::string("'") + SEMSEGMAP_BINARY + "'");
+    const std::string command = "cd '" + dir.path().string() + "' && " +
+                                line.substr(0, line.find(" #")) + " > run.out 2> run.err";
+    const int status = std::system(command.c_str());
+    ASSERT_EQ(status, 0) << line << "\n"
+                         << semsegmap::test_support::readFile(dir.path() / "run.err");
+    ++ran;
+  }
+  EXPECT_EQ(ran, 3u) << "map, localize, convert";
+  // The localize line's output: every frame of the same drive is localized.
+  const std::string summary =
+      semsegmap::test_support::readFile(dir.path() / "tuesday/summary.json");
+  EXPECT_NE(summary.find("\"frames\": 10"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"n_localizations\": 10,"), std::string::npos) << summary;
+  // The drive moves a few metres: the odometry of the bag, not a standing robot.
+  const size_t at = summary.find("\"distance_m\": ");
+  ASSERT_NE(at, std::string::npos) << summary;
+  EXPECT_GT(std::stod(summary.substr(at + 14)), 1.0) << summary;
+  EXPECT_TRUE(fs::exists(dir.path() / "monday.map"));
+  EXPECT_TRUE(fs::exists(dir.path() / "monday"));
 }
 
 // ---- MCAP --------------------------------------------------------------------------------------

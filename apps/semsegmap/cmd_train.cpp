@@ -161,18 +161,24 @@ TrainConfig trainConfig(const CliArgs& a) {
     config.augmentation.confused_section_probability = probability(a, "confused-sections");
   if (a.has("modality-dropout"))
     config.augmentation.modality_dropout_probability = probability(a, "modality-dropout");
-  for (const char* option : {"lidar-only", "modality-dropout"})
+  if (a.has("partial-coverage"))
+    config.augmentation.partial_coverage_probability = probability(a, "partial-coverage");
+  for (const char* option : {"lidar-only", "modality-dropout", "partial-coverage"})
     if (a.has(option) && config.net.kind != DescriptorKind::kSemSegMapNet)
       throw UsageError(std::string("--") + option + ": only semsegmap-net sees colour and classes");
-  if (a.has("lidar-only") && a.has("modality-dropout"))
-    throw UsageError("--modality-dropout: a --lidar-only network sees neither modality anyway");
+  for (const char* option : {"modality-dropout", "partial-coverage"})
+    if (a.has("lidar-only") && a.has(option))
+      throw UsageError(std::string("--") + option +
+                       ": a --lidar-only network sees neither modality anyway");
   if (a.has("lidar-only")) config.net.use_color = config.net.use_classes = false;
   for (const char* option : {"distillation-weight", "from-scratch"})
     if (a.has(option) && !a.has("teacher"))
       throw UsageError(std::string("--") + option + ": only with --teacher");
   // The teacher would see what the dropout took from the student, and teach it nothing.
-  if (a.has("teacher") && a.has("modality-dropout"))
-    throw UsageError("--modality-dropout: the teacher would see the same dropped observation");
+  for (const char* option : {"modality-dropout", "partial-coverage"})
+    if (a.has("teacher") && a.has(option))
+      throw UsageError(std::string("--") + option +
+                       ": the teacher would see the same dropped observation");
   if (a.has("distillation-weight")) {
     config.distillation_weight = a.getNumber("distillation-weight");
     if (!(config.distillation_weight >= 0 && config.distillation_weight <= 1e6))
@@ -300,6 +306,13 @@ const CommandSpec& trainCommand() {
            "or a segmentation network " +
                shown([](const TrainConfig& c) {
                  return c.augmentation.modality_dropout_probability;
+               })},
+          {"partial-coverage", Value::kNumber, "P", "",
+           "probability that a training observation loses colour and classes beyond a vertical "
+           "plane (up to 90 % of its points), as a segment at the edge of a camera's picture "
+           "does on a LiDAR the cameras cover only in part " +
+               shown([](const TrainConfig& c) {
+                 return c.augmentation.partial_coverage_probability;
                })},
           {"lidar-only", Value::kFlag, "", "",
            "the network sees geometry only (no colour, no classes): the model for a LiDAR "

@@ -107,7 +107,8 @@ std::string overview() {
   demo = std::find(listed.begin(), listed.end(), &demoCommand());
 #endif
   listed.insert(demo, evalCommands().begin(), evalCommands().end());
-  return "usage: semsegmap <command> [options]\n       semsegmap --version\n\ncommands:\n" +
+  return "usage: semsegmap <command> [options]\n       semsegmap --version\n       semsegmap "
+         "--check-usage <command> [options]   (parses, runs nothing)\n\ncommands:\n" +
          commandOverview(listed) + absentNote() + "\n" + kDatasetNotes +
          "\nrun 'semsegmap <command> --help' for a command's options and their defaults.\n";
 }
@@ -175,7 +176,10 @@ int usageError(const std::string& name, const std::string& message) {
   return 2;
 }
 
-int run(const std::vector<std::string>& args) {
+// `check_only`: the command line is parsed as the command would (its name, option names, value
+// types and choices) and nothing runs: scripts and the documentation's test check command lines
+// this way without their data.
+int run(const std::vector<std::string>& args, bool check_only) {
   const std::string two_words = args.size() > 1 ? args[0] + " " + args[1] : args[0];
   for (const AbsentCommand& c : absentCommands()) {
     if (args[0] != c.name && two_words != c.name) continue;
@@ -196,6 +200,10 @@ int run(const std::vector<std::string>& args) {
       return 0;
     }
     const CliArgs parsed(*command, rest);
+    if (check_only) {
+      std::cout << "semsegmap " << name << ": usage ok\n";
+      return 0;
+    }
     // Notes and warnings of the library on a line of their own, never after a progress bar.
     setMessageSink([](const std::string& line) {
       endProgressLine();
@@ -234,5 +242,12 @@ int main(int argc, char** argv) {
     std::cout << "semsegmap " << SEMSEGMAP_VERSION << "\n";
     return 0;
   }
-  return semsegmap::app::run(args);
+  if (args[0] == "--check-usage") {
+    if (args.size() < 2) {
+      std::cerr << "semsegmap --check-usage: usage error: a command line to check follows\n";
+      return 2;
+    }
+    return semsegmap::app::run({args.begin() + 1, args.end()}, true);
+  }
+  return semsegmap::app::run(args, false);
 }

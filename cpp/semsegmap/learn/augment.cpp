@@ -87,13 +87,9 @@ EnrichedCloud cutByPlane(const EnrichedCloud& cloud, const Eigen::Vector3f& norm
 
 namespace {
 
-// Which points lie beyond a plane of random direction placed so that about `fraction` of them
-// do; at least one point stays on the near side.
-std::vector<bool> beyondRandomPlane(const EnrichedCloud& cloud, double fraction,
-                                    std::mt19937& rng) {
-  // A direction uniform on the sphere.
-  std::normal_distribution<float> g(0.0f, 1.0f);
-  Eigen::Vector3f n(g(rng), g(rng), g(rng));
+// Which points lie beyond the plane of normal n placed so that about `fraction` of them do; at
+// least one point stays on the near side.
+std::vector<bool> beyondPlane(const EnrichedCloud& cloud, Eigen::Vector3f n, double fraction) {
   if (n.norm() < 1e-6f) n = Eigen::Vector3f::UnitX();
   n.normalize();
   const Eigen::Vector3f c = centroidOf(cloud);
@@ -109,6 +105,16 @@ std::vector<bool> beyondRandomPlane(const EnrichedCloud& cloud, double fraction,
   std::vector<bool> beyond(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) beyond[i] = d[i] > offset;
   return beyond;
+}
+
+// A plane of direction uniform on the sphere.
+std::vector<bool> beyondRandomPlane(const EnrichedCloud& cloud, double fraction,
+                                    std::mt19937& rng) {
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  // Left as the shipped models drew it (argument order is the compiler's), so that their
+  // recipe still reproduces them.
+  const Eigen::Vector3f n(g(rng), g(rng), g(rng));
+  return beyondPlane(cloud, n, fraction);
 }
 
 }  // namespace
@@ -134,6 +140,20 @@ EnrichedCloud confuseSection(const EnrichedCloud& cloud, double fraction, std::m
     out[i].class_id = cls::isThin(c) ? (pick ? cls::kBuilding : cls::kVegetation)
                                      : cls::confusionPartner(c, pick);
   }
+  return out;
+}
+
+EnrichedCloud unobserveSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng) {
+  if (cloud.empty() || fraction <= 0) return cloud;
+  // A camera's frustum edge is a plane through its centre and the vertical: horizontal normal.
+  const double angle =
+      std::uniform_real_distribution<double>(0.0, 2.0 * 3.14159265358979323846)(rng);
+  const Eigen::Vector3f n(static_cast<float>(std::cos(angle)), static_cast<float>(std::sin(angle)),
+                          0.0f);
+  const std::vector<bool> beyond = beyondPlane(cloud, n, fraction);
+  EnrichedCloud out = cloud;
+  for (size_t i = 0; i < out.size(); ++i)
+    if (beyond[i]) out[i] = dropModalities({out[i]}, true, true).front();
   return out;
 }
 
@@ -207,6 +227,9 @@ EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, s
     const bool drop_color = dropped(rng);  // drawn first: argument order is unspecified
     out = dropModalities(out, drop_color, dropped(rng));
   }
+  if (config.partial_coverage_probability > 0 &&
+      std::bernoulli_distribution(config.partial_coverage_probability)(rng))
+    out = unobserveSection(out, uniform(rng, 0.0, config.max_unobserved_fraction), rng);
   return out;
 }
 

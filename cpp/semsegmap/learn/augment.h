@@ -35,6 +35,12 @@ struct AugmentConfig {
   // few: with this probability, drawn separately for each, an observation loses all its colour
   // or all its classes. 0 keeps the draws of the recipe before it.
   double modality_dropout_probability = 0.0;
+  // A camera that covers only part of the LiDAR (one front camera on a 360-degree scanner) sees
+  // part of a segment at the edge of its picture: with this probability the points beyond a
+  // vertical plane (the frustum's edge), up to max_unobserved_fraction of them, lose colour and
+  // class. 0 keeps the draws of the recipe before it.
+  double partial_coverage_probability = 0.0;
+  double max_unobserved_fraction = 0.9;
   int num_classes = 15;  // wrong classes are drawn from 1 .. num_classes - 1
 };
 
@@ -71,6 +77,11 @@ EnrichedCloud confuseSection(const EnrichedCloud& cloud, double fraction, std::m
 // (unobserved, has_class false) when drop_classes: the observation as a sensor without that
 // modality gives it.
 EnrichedCloud dropModalities(const EnrichedCloud& cloud, bool drop_color, bool drop_classes);
+
+// A vertical plane of random horizontal direction, placed so that about `fraction` of the
+// points lie beyond it; those lose colour and class (unobserved), as beyond a camera's frustum.
+// At least one point stays observed.
+EnrichedCloud unobserveSection(const EnrichedCloud& cloud, double fraction, std::mt19937& rng);
 
 // All of the above with random strengths within `config`.
 EnrichedCloud augment(const EnrichedCloud& cloud, const AugmentConfig& config, std::mt19937& rng);
