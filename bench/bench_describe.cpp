@@ -89,6 +89,7 @@ std::string modelFile(DescriptorKind kind) {
 // state.range(0): descriptor kind (2 segmap-cnn, 3 semsegmap-net); range(1): threads.
 void BM_LearnedDescribe(benchmark::State& state) {
   const auto kind = static_cast<DescriptorKind>(state.range(0));
+  keepFreedMemoryForTorch();  // as the command line does at start-up
   const auto describer = makeLearnedDescriber(
       kind, {loadNet(modelFile(kind), kind), static_cast<int>(state.range(1))});
   std::vector<DescriptorInput> batch;

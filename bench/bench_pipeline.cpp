@@ -8,6 +8,7 @@
 #include <benchmark/benchmark.h>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/io/class_map_file.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
@@ -66,6 +67,7 @@ void BM_WholePipeline(benchmark::State& state) {
   const PipelineConfig config =
       loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/" + name + ".yaml");
   std::shared_ptr<Describer> describer;
+  keepFreedMemoryForTorch();  // as the command line does at start-up
   try {
     describer = makeDescriber(config.descriptor);
   } catch (const std::exception& e) {

@@ -23,6 +23,7 @@
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/open_dataset.h"
+#include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/io/config.h"
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/input_modalities.h"
@@ -162,6 +163,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  semsegmap::keepFreedMemoryForTorch();  // as the command line does
   try {
     return run(argc, argv);
   } catch (const std::exception& e) {

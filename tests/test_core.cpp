@@ -152,6 +152,20 @@ TEST(SensorRig, LidarBeamsSpanTheFieldOfView) {
   EXPECT_NEAR(std::asin(last.z()) * 180 / M_PI, l.vfov_down_deg, 1e-9);
 }
 
+// One HDL-64E: the simulator's preset renders the beams real KITTI scans are read with, at 2048
+// of the real 2083 columns (its ray budget) and with the simulator's range defaults.
+TEST(SensorRig, TheHdl64PresetHasTheRealSensorsBeams) {
+  const LidarModel real = velodyneHdl64e(), preset = lidarPreset("hdl64");
+  EXPECT_EQ(real.columns, 2083);
+  EXPECT_EQ(preset.columns, 2048);
+  EXPECT_EQ(preset.rows, real.rows);
+  EXPECT_EQ(preset.hfov_deg, real.hfov_deg);
+  EXPECT_EQ(preset.vfov_up_deg, real.vfov_up_deg);
+  EXPECT_EQ(preset.vfov_down_deg, real.vfov_down_deg);
+  EXPECT_EQ(preset.max_range_m, LidarModel{}.max_range_m);
+  EXPECT_EQ(real.dropout, 0.0) << "real scans carry their own dropouts";
+}
+
 TEST(SensorRig, ValidateNamesTheBadField) {
   SensorRig rig = defaultSimRig();
   rig.cameras[2].fx = -1.0;

@@ -13,6 +13,9 @@
 #include "progress.h"
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/io/run_output.h"
+#if SEMSEGMAP_WITH_TORCH
+#include "semsegmap/describe/learned_describer.h"
+#endif
 
 #ifndef SEMSEGMAP_VERSION
 #error "SEMSEGMAP_VERSION comes from apps/semsegmap/CMakeLists.txt (the CMake project version)"
@@ -230,6 +233,9 @@ int run(const std::vector<std::string>& args, bool check_only) {
 
 int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 1, argv + argc);
+#if SEMSEGMAP_WITH_TORCH
+  semsegmap::keepFreedMemoryForTorch();  // the program's choice, not the library's
+#endif
   if (args.empty()) {
     std::cerr << semsegmap::app::overview();
     return 2;

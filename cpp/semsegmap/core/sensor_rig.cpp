@@ -217,12 +217,26 @@ LidarModel spinning(int columns, int rows, double hfov_deg, double up_deg, doubl
 
 }  // namespace
 
+LidarModel velodyneHdl64e() {
+  LidarModel m = spinning(2083, 64, 360.0, 2.0, -24.8);  // 0.1728 deg azimuth step at 10 Hz
+  m.min_range_m = 0.9;
+  m.max_range_m = 120.0;
+  m.range_noise_m = 0.02;
+  m.dropout = 0.0;  // real scans already carry their dropouts
+  return m;
+}
+
 // Column counts are the sensors' azimuth steps at 10 Hz, rounded so that the simulator's ray
 // budget stays near the paper rig's (a 4500-column HDL-64E would cost 2.3 times as much and
 // change no segment: 0.1 m voxels are coarser than its spacing beyond 4 m).
 LidarModel lidarPreset(const std::string& name) {
   if (name == "paper") return LidarModel{};
-  if (name == "hdl64") return spinning(2048, 64, 360.0, 2.0, -24.8);
+  if (name == "hdl64") {
+    // The real sensor's beams with 2048 columns and the simulator's range and dropout defaults,
+    // as every simulated HDL-64E result and model so far was rendered.
+    const LidarModel real = velodyneHdl64e();
+    return spinning(2048, real.rows, real.hfov_deg, real.vfov_up_deg, real.vfov_down_deg);
+  }
   if (name == "vlp32") return spinning(1800, 32, 360.0, 15.0, -25.0);
   if (name == "os128") return spinning(1024, 128, 360.0, 22.5, -22.5);
   if (name == "solid") {

@@ -84,10 +84,15 @@ struct SensorRig {
 // (left, front, right) at 640 x 480, mounted with a few decimetres of parallax.
 SensorRig defaultSimRig();
 
+// The Velodyne HDL-64E as its recordings are (datasheet values at 10 Hz: 2083 columns, 64 rows,
+// +2 to -24.8 degrees, 0.9-120 m): the LiDAR of the readers of real KITTI data, and the beams of
+// the simulator's `hdl64` preset.
+LidarModel velodyneHdl64e();
+
 // Beam patterns of common real LiDARs, so that the simulator can render what they see and
 // descriptors can be trained on more than one sensor:
 //   paper  1920 x 64 over 270 degrees, +2 to -24.8 (the default; the paper's rig)
-//   hdl64  Velodyne HDL-64E as in KITTI: 2048 x 64 over 360 degrees, +2 to -24.8
+//   hdl64  Velodyne HDL-64E as in KITTI (velodyneHdl64e's beams, 2048 of its 2083 columns)
 //   vlp32  a 32-beam spinning LiDAR (VLP-32C-like): 1800 x 32 over 360 degrees, +15 to -25
 //   os128  a 128-beam spinning LiDAR (OS1-128-like): 1024 x 128 over 360 degrees, +22.5 to -22.5
 //   solid  a forward-looking solid-state LiDAR: 600 x 96 over 70 degrees, +12 to -12

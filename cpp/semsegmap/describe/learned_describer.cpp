@@ -62,7 +62,6 @@ class LearnedDescriber : public Describer {
       throw std::invalid_argument("makeLearnedDescriber: " + descriptorName(kind) +
                                   " needs a network of its kind (DescriberOptions::net, loadNet)");
     }
-    keepFreedMemoryForTorch();
     net_ = options.net;
     net_->eval();
     fingerprint_ = netFingerprint(*net_);

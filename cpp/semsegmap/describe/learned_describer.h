@@ -22,8 +22,9 @@ constexpr int kLearnedChunk = 64;
 // glibc's malloc: allocations up to 32 MB come from the heap, and up to 512 MB of freed heap stay
 // with the process. Every batch allocates and frees tens of MB of activations; with glibc's
 // defaults they go back to the system and fault back in page by page, which measured 40-50 % of
-// the inference time. Process-wide, idempotent, a no-op elsewhere than glibc;
-// makeLearnedDescriber calls it, and training gains the same from it.
+// the inference time. Process-wide, so the library never calls it behind its caller's back: a
+// program that describes or trains calls it once (the command line and the benchmarks do).
+// Idempotent, a no-op elsewhere than glibc.
 void keepFreedMemoryForTorch();
 
 }  // namespace semsegmap

@@ -202,20 +202,6 @@ Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam, const KittiCalibFi
   return cam;
 }
 
-LidarModel velodyneHdl64e() {
-  LidarModel m;
-  m.columns = 2083;  // 0.1728 deg azimuth step at 10 Hz
-  m.rows = 64;
-  m.hfov_deg = 360.0;
-  m.vfov_up_deg = 2.0;
-  m.vfov_down_deg = -24.8;
-  m.min_range_m = 0.9;
-  m.max_range_m = 120.0;
-  m.range_noise_m = 0.02;
-  m.dropout = 0.0;  // real scans already carry their dropouts
-  return m;
-}
-
 double kittiScanTime(const std::vector<double>* times, const std::filesystem::path& times_path,
                      size_t number, double rate_hz) {
   if (!times) return static_cast<double>(number) / rate_hz;

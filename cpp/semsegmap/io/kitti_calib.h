@@ -104,7 +104,4 @@ Camera kittiProjectionCamera(const KittiCalibFile& calib, const std::string& p_k
 Camera kittiRectifiedCamera(const KittiCalibFile& cam_to_cam, const KittiCalibFile& velo_to_cam,
                             int index);
 
-// The Velodyne HDL-64E of KITTI (datasheet values at 10 Hz), for rigs of real KITTI data.
-LidarModel velodyneHdl64e();
-
 }  // namespace semsegmap
