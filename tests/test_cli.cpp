@@ -366,6 +366,43 @@ TEST(Cli, UsageErrorsExitTwoWithAHint) {
             std::string::npos);
 }
 
+// A typo gets the nearest known name in its one line: a command, an option (also with one dash),
+// an experiment, a choice; a word far from every name gets no guess.
+TEST(Cli, UnknownNamesSuggestTheNearestKnownOne) {
+  auto expectUsage = [](const std::string& args, const std::string& line) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_EQ(r.err.substr(0, r.err.find('\n')), line) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;  // and the --help hint
+  };
+  expectUsage("localise --dataset d",
+              "semsegmap: usage error: unknown command 'localise' (did you mean localize?)");
+  expectUsage("lcoalize",
+              "semsegmap: usage error: unknown command 'lcoalize' (did you mean "
+              "localize?)");  // two letters swapped: one edit
+  expectUsage("--verison",
+              "semsegmap: usage error: unknown command '--verison' (did you mean "
+              "--version?)");
+  expectUsage("frobnicate", "semsegmap: usage error: unknown command 'frobnicate'");
+  expectUsage("map --dataset d --config c --out o --odometrie x.txt",
+              "semsegmap map: usage error: unknown option --odometrie (did you mean --odometry?)");
+  expectUsage("map --dataset d --config c --out o --Max-Frame=2",
+              "semsegmap map: usage error: unknown option --Max-Frame (did you mean "
+              "--max-frames?)");
+  expectUsage("map --dataset d --out o -config c",
+              "semsegmap map: usage error: unexpected argument '-config' (did you mean --config?)");
+  expectUsage("map --dataset d --config c --out o --zz 1",
+              "semsegmap map: usage error: unknown option --zz");
+  expectUsage("segment --dataset d --config c --out o --poses odmo",
+              "semsegmap segment: usage error: option --poses expects gt|odom, got 'odmo' (did "
+              "you mean odom?)");
+  // eval revisits is in every build.
+  expectUsage("eval revisit --out o",
+              "semsegmap eval: usage error: unknown experiment 'revisit' (did you mean revisits?)");
+  const Result far = run("eval nonsense --out o");
+  EXPECT_NE(far.err.find("unknown experiment 'nonsense' (expected "), std::string::npos) << far.err;
+}
+
 TEST(Cli, NegativeMaxFramesIsAUsageErrorEverywhere) {
   for (const CommandOptions& c : kCommands) {
     if (std::find(c.options.begin(), c.options.end(), "max-frames") == c.options.end()) continue;

@@ -135,6 +135,26 @@ bool asksForHelp(const std::vector<std::string>& args) {
   return false;
 }
 
+// The first words a command line may start with, for the hint after an unknown one: the
+// commands, those this build leaves out (which then say why), and the options of `semsegmap`
+// itself.
+std::vector<std::string> firstWords() {
+  std::vector<std::string> words = {"eval", "--help", "--version", "--check-usage"};
+  for (const CommandSpec* c : commands()) words.push_back(c->name);
+  for (const AbsentCommand& c : absentCommands())
+    if (c.name.find(' ') == std::string::npos) words.push_back(c.name);
+  return words;
+}
+
+// An unknown experiment: the nearest one when it looks like a typo, else the list.
+UsageError unknownExperiment(const std::string& typed) {
+  std::vector<std::string> experiments;
+  for (const CommandSpec* c : evalCommands()) experiments.push_back(c->name.substr(5));
+  const std::string hint = didYouMean(typed, experiments);
+  return UsageError("unknown experiment '" + typed + "'" +
+                    (hint.empty() ? " (expected " + experimentList() + ")" : hint));
+}
+
 // The command `args` names (one word, or two after `eval`); `name` is set to what was found so
 // far, for the error messages. Throws UsageError for an unknown one.
 const CommandSpec* findCommand(const std::vector<std::string>& args, std::string* name) {
@@ -143,7 +163,8 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
     *name = c->name;
     return c;
   }
-  if (args[0] != "eval") throw UsageError("unknown command '" + args[0] + "'");
+  if (args[0] != "eval")
+    throw UsageError("unknown command '" + args[0] + "'" + didYouMean(args[0], firstWords()));
   *name = "eval";
   if (args.size() < 2 || args[1].rfind("-", 0) == 0)
     throw UsageError("eval needs an experiment: " + experimentList());
@@ -152,7 +173,7 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
     *name = c->name;
     return c;
   }
-  throw UsageError("unknown experiment '" + args[1] + "' (expected " + experimentList() + ")");
+  throw unknownExperiment(args[1]);
 }
 
 // What a command writes: --out and the options naming another file it writes; a DIR placeholder
