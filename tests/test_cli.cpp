@@ -438,6 +438,52 @@ TEST(Cli, EqualsFormAndProgressIntoAFile) {
   EXPECT_LE(lines, 11) << r.err;
 }
 
+// A path without a kind that is no dataset directory: the one-line error names it and says what
+// to write instead, as far as the path's name and a look at its entries tell.
+TEST(CliDatasetSpecs, APathWithoutAKindSaysWhatToWriteInstead) {
+  TempDir tmp;
+  namespace fs = std::filesystem;
+  const std::string d = tmp.path().string();
+  std::ofstream(d + "/run.bag") << "never read";
+  fs::create_directories(d + "/drive/velodyne_points/data");
+  fs::create_directories(d + "/date/2011_09_26_drive_0001_sync/velodyne_points/data");
+  fs::create_directories(d + "/seq/velodyne");
+  std::ofstream(d + "/seq/velodyne/000000.bin") << "";
+  fs::create_directories(d + "/ros2");
+  std::ofstream(d + "/ros2/metadata.yaml") << "";
+  std::ofstream(d + "/ros2/ros2_0.db3") << "";
+  fs::create_directories(d + "/scans");
+  std::ofstream(d + "/scans/000000.pcd") << "";
+  std::ofstream(d + "/notes.txt") << "x";
+  auto expectLine = [&](const std::string& path, const std::string& message) {
+    const Result r = run("convert --dataset " + path + " --out " + d + "/out");
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(r.err, "semsegmap convert: error: " + path + ": " + message + "\n");
+    EXPECT_FALSE(fs::exists(d + "/out")) << "a failed run left its folder";
+  };
+  const std::string folder = ", not a dataset directory of the project's format: write ";
+  expectLine(d + "/run.bag",
+             "a ROS 1 bag, not a dataset directory: write rosbag:" + d + "/run.bag");
+  expectLine(d + "/ros2", "a ROS 2 bag folder" + folder + "rosbag:" + d + "/ros2");
+  expectLine(d + "/drive", "a KITTI raw drive" + folder + "kitti-raw:" + d + "/drive");
+  expectLine(d + "/date", "a folder holding a KITTI raw drive" + folder + "kitti-raw:" + d +
+                              "/date/2011_09_26_drive_0001_sync");
+  expectLine(d + "/seq/velodyne/000000.bin",
+             "a scan of a SemanticKITTI or KITTI odometry sequence, not a dataset directory: "
+             "write semantickitti:" +
+                 d + "/seq");
+  expectLine(d + "/scans/000000.pcd",
+             "a scan, not a dataset directory: write folder:" + d + "/scans");
+  expectLine(d + "/notes.txt",
+             "a file, not a dataset directory (a dataset is a directory, or KIND:PATH with "
+             "kitti-raw:, semantickitti:, nclt:, folder:, rosbag:)");
+  expectLine(d + "/none", "no such dataset directory");
+  const Result kind = run("convert --dataset rosbg:" + d + "/run.bag --out " + d + "/out");
+  EXPECT_EQ(kind.code, 1);
+  EXPECT_NE(kind.err.find("unknown kind 'rosbg' (did you mean rosbag:?)\n"), std::string::npos)
+      << kind.err;
+}
+
 // A dataset or descriptor the build left out: one line naming the option, exit 1.
 TEST(Cli, PartsNotInThisBuildSayWhyInOneLine) {
   if (SEMSEGMAP_WITH_SIM && SEMSEGMAP_WITH_TORCH && SEMSEGMAP_WITH_PCL)
