@@ -702,6 +702,7 @@ const std::filesystem::path& simulatedDataset() {
     Made m;
     m.dir = std::filesystem::temp_directory_path() /
             ("semsegmap_cli_data_" + std::to_string(::getpid())) / "tiny";
+    std::filesystem::create_directories(m.dir.parent_path());  // an output's folder must exist
     const Result r = run("simulate --world tiny --run S2 --max-frames 3 --out " + m.dir.string());
     EXPECT_EQ(r.code, 0) << r.err;
     return m;
@@ -938,6 +939,94 @@ TEST(CliUpFront, OutputsOfTheWrongKindOrUnwritableFailBeforeFrame0) {
   ::chmod(locked.c_str(), 0755);
 }
 
+// The arguments that fill a command's required options other than --out with a value each
+// (a choice's first one): enough to parse, not to run.
+std::string requiredOptionsBut(const std::string& command, const std::string& except) {
+  // Each option's line with the lines its help wraps onto.
+  std::vector<std::string> entries;
+  std::istringstream in(help(command).out);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("  --", 0) == 0)
+      entries.push_back(line);
+    else if (!entries.empty() && line.rfind("    ", 0) == 0)
+      entries.back() += line;
+  }
+  std::string args;
+  for (const std::string& entry : entries) {
+    if (entry.find("(required)") == std::string::npos) continue;
+    const auto options = helpOptions(entry + "\n");
+    if (options.empty() || options.front().first == except) continue;
+    const auto& [name, placeholder] = options.front();
+    args +=
+        " --" + name + " " +
+        (placeholder.find('|') != std::string::npos ? placeholder.substr(0, placeholder.find('|'))
+                                                    : std::string("1"));
+  }
+  return args;
+}
+
+// Every command the same: the folder an output goes into must exist. A mistyped --out is refused
+// in one line naming that folder, before any work, and nothing is made (it used to grow the
+// missing folders silently).
+TEST(CliOutputs, EveryCommandRefusesAnOutputWhoseFolderIsMissing) {
+  TempDir tmp;
+  const std::filesystem::path missing = tmp.path() / "nonexistent" / "dir";
+  for (const CommandOptions& c : kCommands) {
+    SCOPED_TRACE(c.command);
+    const Result r = run(c.command + requiredOptionsBut(c.command, "out") + " --out " +
+                         (missing / "x.out").string());
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(r.err, "semsegmap " + c.command + ": error: " + (missing / "x.out").string() +
+                         ": --out cannot be written: its folder " + missing.string() +
+                         " does not exist (create it first, or choose another)\n");
+    EXPECT_FALSE(std::filesystem::exists(tmp.path() / "nonexistent"));
+  }
+  // An output folder itself may be new, as long as its own folder exists: the failure is then
+  // the dataset's, and the folder made for the run is gone again.
+  const Result segment =
+      run("segment --dataset " + (tmp.path() / "none").string() + " --config " +
+          eigenConfig(tmp.path(), "eigen.yaml") + " --out " + (tmp.path() / "seg").string());
+  EXPECT_EQ(segment.code, 1);
+  EXPECT_NE(segment.err.find("none: no such dataset directory"), std::string::npos) << segment.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp.path() / "seg"));
+}
+
+// A second run into the outputs of a first overwrites them, saying so in one line per output
+// (the rule for every command: `make demo` runs into demo_out each time); a failed run into them
+// leaves them as they were.
+TEST(CliOutputs, ASecondRunReplacesTheFirstOnesOutputsSayingSo) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path sim = tmp.path() / "sim", png = tmp.path() / "overview.png";
+  const std::string simulate =
+      "simulate --world tiny --run S2 --max-frames 1 --no-cameras --out " + sim.string();
+  Result r = run(simulate);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("note: --out"), std::string::npos) << r.err;
+  r = run(simulate);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("note: --out " + sim.string() + " already holds "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(" entries: this run's files replace those of the same name, the others "
+                       "stay\n"),
+            std::string::npos)
+      << r.err;
+  const std::string overview = "simulate-overview --world tiny --out " + png.string();
+  ASSERT_EQ(run(overview).code, 0);
+  const auto first = std::filesystem::last_write_time(png);
+  r = run(overview);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("note: --out " + png.string() + " exists: this run replaces it\n"),
+            std::string::npos)
+      << r.err;
+  EXPECT_GE(std::filesystem::last_write_time(png), first);
+  // A failed run into the first one's folder keeps what was there.
+  const std::string frames = readFile(sim / "frames.csv");
+  r = run("convert --dataset " + (tmp.path() / "none").string() + " --out " + sim.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(readFile(sim / "frames.csv"), frames);
+}
+
 TEST(CliUpFront, AMissingLabelImageIsFoundBeforeFrame0) {
   if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
   TempDir tmp;
@@ -1130,10 +1219,10 @@ TEST_F(CliMaps, AFailedRunLeavesNoOutputsBehind) {
   EXPECT_NE(segment.err.find("cam0/000001.png"), std::string::npos) << segment.err;
   EXPECT_FALSE(std::filesystem::exists(tmp_.path() / "seg"));
 
-  const Result map = run("map" + bad + " --config " + config_ + " --out " +
-                         (tmp_.path() / "new" / "sub" / "x.map").string());
+  const Result map =
+      run("map" + bad + " --config " + config_ + " --out " + (tmp_.path() / "x.map").string());
   EXPECT_EQ(map.code, 1) << map.err;
-  EXPECT_FALSE(std::filesystem::exists(tmp_.path() / "new"));
+  EXPECT_FALSE(std::filesystem::exists(tmp_.path() / "x.map"));
 
   // A folder that was there keeps what it had, and nothing of the failed run.
   std::filesystem::create_directories(out() / "old");

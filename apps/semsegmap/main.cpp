@@ -176,18 +176,35 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
   throw unknownExperiment(args[1]);
 }
 
+bool isOutput(const OptionSpec& o) {
+  return o.name == "out" || o.name == "ply" || o.name == "history" ||
+         (o.name == "cameras" && o.placeholder == "FILE.png");
+}
+
+// One line for an output that is there already: it is overwritten, the same rule for every
+// command, since runs are repeated into one folder (`make demo`, an evaluation after a change).
+std::string replacedNote(const std::string& option, const std::string& path, size_t entries,
+                         bool folder) {
+  if (!folder) return option + " " + path + " exists: this run replaces it";
+  return option + " " + path + " already holds " + std::to_string(entries) +
+         (entries == 1 ? " entry" : " entries") +
+         ": this run's files replace those of the same name, the others stay";
+}
+
 // What a command writes: --out and the options naming another file it writes; a DIR placeholder
-// says a folder. Checked before the command starts, removed again when it fails.
+// says a folder. Checked before the command starts, removed again when it fails; what is there
+// already is said, once every output passed its check.
 void declareOutputs(const CliArgs& a, RunOutputs& outputs) {
+  std::vector<std::string> replaced;
   for (const OptionSpec& o : a.command().options) {
-    const bool output = o.name == "out" || o.name == "ply" || o.name == "history" ||
-                        (o.name == "cameras" && o.placeholder == "FILE.png");
-    if (!output || (!a.has(o.name) && o.fallback.empty())) continue;
-    if (o.placeholder == "DIR")
-      outputs.folder(a.get(o.name), "--" + o.name);
-    else
-      outputs.file(a.get(o.name), "--" + o.name);
+    if (o.name == "cache" && a.has("cache")) outputs.keptFile(a.get("cache"), "--cache");
+    if (!isOutput(o) || (!a.has(o.name) && o.fallback.empty())) continue;
+    const std::string option = "--" + o.name, path = a.get(o.name);
+    const bool folder = o.placeholder == "DIR";
+    const size_t before = folder ? outputs.folder(path, option) : outputs.file(path, option);
+    if (before > 0) replaced.push_back(replacedNote(option, path, before, folder));
   }
+  for (const std::string& line : replaced) note(line);
 }
 
 int usageError(const std::string& name, const std::string& message) {
