@@ -71,6 +71,9 @@ const std::vector<CommandOptions> kAllCommands = {
     {"simulate-overview",
      {"world-seed", "world", "out", "cameras", "run", "frame"},
      {"max-frames", "dataset"}},
+    {"info",
+     {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "json"},
+     {"out", "config", "max-frames"}},
     {"enrich",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "frame", "out",
       "width", "ply", "camera", "config"},
@@ -973,11 +976,14 @@ TEST(CliOutputs, EveryCommandRefusesAnOutputWhoseFolderIsMissing) {
   const std::filesystem::path missing = tmp.path() / "nonexistent" / "dir";
   for (const CommandOptions& c : kCommands) {
     SCOPED_TRACE(c.command);
-    const Result r = run(c.command + requiredOptionsBut(c.command, "out") + " --out " +
+    // Every command writes --out, but info, which writes --json only when asked.
+    const bool out = std::find(c.options.begin(), c.options.end(), "out") != c.options.end();
+    const std::string option = out ? "out" : "json";
+    const Result r = run(c.command + requiredOptionsBut(c.command, option) + " --" + option + " " +
                          (missing / "x.out").string());
     EXPECT_EQ(r.code, 1) << r.err;
     EXPECT_EQ(r.err, "semsegmap " + c.command + ": error: " + (missing / "x.out").string() +
-                         ": --out cannot be written: its folder " + missing.string() +
+                         ": --" + option + " cannot be written: its folder " + missing.string() +
                          " does not exist (create it first, or choose another)\n");
     EXPECT_FALSE(std::filesystem::exists(tmp.path() / "nonexistent"));
   }
@@ -1322,6 +1328,126 @@ TEST(CliEvalSemantics, LabelsThenEvalOnTheRealMiniKitti) {
   r = run("eval semantics" + dataset + " --config config/lidar-camera.yaml --out " + out.string());
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("frame 0 has no label image in any camera"), std::string::npos) << r.err;
+}
+
+// ---------------------------------------------------------------------------------------------
+// semsegmap info: what a dataset holds and what its reader picked, before a long run
+
+// The lines of `info`'s output that start with `key: `, without the key.
+std::string infoLine(const std::string& out, const std::string& key) {
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(key + ": ", 0) == 0) return line.substr(key.size() + 2);
+  return "(no " + key + " line)";
+}
+
+// A folder of two scans named by frame number with a KITTI pose file for odometry: the kind, the
+// frames, the LiDAR's files and points, no camera, the pose file and the rule that matched it.
+TEST(CliInfo, SaysWhatATinyFolderDatasetHoldsAndHowItsPosesWereMatched) {
+  TempDir tmp;
+  const std::filesystem::path scans = tmp.path() / "scans";
+  std::filesystem::create_directories(scans);
+  for (const char* name : {"000000.bin", "000001.bin"}) {
+    std::ofstream bin(scans / name, std::ios::binary);
+    const float points[8] = {5.0f, 1.0f, 0.5f, 0.0f, 6.0f, -1.0f, 0.2f, 0.0f};
+    bin.write(reinterpret_cast<const char*>(points), sizeof(points));
+  }
+  std::ofstream(tmp.path() / "odom.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n";
+  const std::filesystem::path json = tmp.path() / "info.json";
+  const Result r = run("info --dataset folder:" + scans.string() + " --odometry " +
+                       (tmp.path() / "odom.txt").string() + " --json " + json.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(infoLine(r.out, "dataset"),
+            "folder:scans, read as folder, no rig file (a LiDAR alone)");
+  EXPECT_EQ(infoLine(r.out, "frames"),
+            "2 over 0.10 s (0.000 to 0.100, times made up from the rate)");
+  EXPECT_EQ(infoLine(r.out, "lidar"), (scans / "*").string() +
+                                          ".bin, no times (made up from the rate); 2 points in "
+                                          "frame 0, 10.0 Hz");
+  EXPECT_EQ(infoLine(r.out, "cameras"), "none (geometry only)");
+  EXPECT_EQ(infoLine(r.out, "odometry"),
+            (tmp.path() / "odom.txt").string() + " (KITTI poses matched by frame number)");
+  EXPECT_EQ(infoLine(r.out, "ground truth"), "none");
+  EXPECT_EQ(infoLine(r.out, "labels"), "none");
+  const std::string written = readFile(json);
+  EXPECT_NE(written.find("\"count\": 2,"), std::string::npos) << written;
+  EXPECT_NE(written.find("\"points_in_frame_0\": 2,"), std::string::npos) << written;
+  EXPECT_NE(written.find("\"is_ground_truth\": false"), std::string::npos) << written;
+  // Without the pose file: no odometry, and the line says how to give it.
+  const Result none = run("info --dataset folder:" + scans.string());
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(infoLine(none.out, "odometry"), "none (give --odometry FILE, or --odometry lidar)");
+}
+
+// A dataset directory with cameras and labels (the simulator's, written to disk): every camera
+// with its files, lens and extrinsics; odometry and ground truth from frames.csv; the labels.
+TEST(CliInfo, SaysWhatADatasetDirectoryWithCamerasHolds) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  const std::filesystem::path data = simulatedDataset();
+  const Result r = run("info --dataset " + data.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(infoLine(r.out, "dataset").find(", read as dataset directory"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(infoLine(r.out, "frames").rfind("3 over 0.40 s", 0), 0u) << r.out;
+  EXPECT_NE(infoLine(r.out, "lidar").find("lidar/NNNNNN.bin; "), std::string::npos) << r.out;
+  EXPECT_EQ(infoLine(r.out, "camera front"),
+            "cam1/NNNNNN.png; 640x480 pinhole fx 320.00 fy 320.00 cx 320.00 cy 240.00; "
+            "T_camera_lidar xyz 0.000 -0.250 -0.350 m, rpy 90.00 -90.00 0.00 deg; T_lidar_camera "
+            "xyz 0.350 0.000 -0.250 m, rpy -90.00 0.00 -90.00 deg")
+      << r.out;
+  EXPECT_EQ(infoLine(r.out, "odometry"), "frames.csv (odom_ columns)");
+  EXPECT_EQ(infoLine(r.out, "ground truth"), "frames.csv (gt_ columns)");
+  EXPECT_EQ(infoLine(r.out, "labels"),
+            "images cam0_label/, cam1_label/, cam2_label/ (3 of 3 cameras in frame 0); per point "
+            "lidar_gt/NNNNNN.bin");
+}
+
+// The real KITTI raw sample: its one camera with KITTI's calibration, no oxts (so no odometry
+// unless asked for), and --odometry lidar named as the source.
+TEST(CliInfo, SaysWhatTheRealKittiRawSampleHolds) {
+  const std::filesystem::path sample = std::filesystem::path(SEMSEGMAP_SHARED_DATA) /
+                                       "kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
+  if (!std::filesystem::exists(sample))
+    GTEST_SKIP() << "the real KITTI raw sample is absent (" << sample.string() << ")";
+  const Result r = run("info --dataset kitti-raw:" + sample.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(infoLine(r.out, "dataset"), "kitti-raw:sample_sync, read as kitti-raw");
+  EXPECT_EQ(infoLine(r.out, "frames").rfind("10 over ", 0), 0u) << r.out;
+  const std::string lidar = infoLine(r.out, "lidar");
+  EXPECT_EQ(lidar.rfind("velodyne_points/data/*.bin; ", 0), 0u) << lidar;
+  EXPECT_GT(std::stoul(lidar.substr(lidar.find("; ") + 2)), 100000u) << "an HDL-64E scan";
+  const std::string camera = infoLine(r.out, "camera image_02");
+  EXPECT_EQ(camera.rfind("image_02/data/*.png, calibration ", 0), 0u) << r.out;
+  EXPECT_NE(camera.find("; 1242x375 pinhole fx 721.54 fy 721.54 cx 609.56 cy 172.85; "),
+            std::string::npos)
+      << camera;
+  EXPECT_EQ(infoLine(r.out, "odometry"), "none (give --odometry FILE, or --odometry lidar)");
+  EXPECT_EQ(infoLine(r.out, "ground truth"), "none");
+  const Result lidar_odometry =
+      run("info --dataset kitti-raw:" + sample.string() + " --odometry lidar");
+  ASSERT_EQ(lidar_odometry.code, 0) << lidar_odometry.err;
+  EXPECT_EQ(infoLine(lidar_odometry.out, "odometry"), "LiDAR odometry on the scans");
+}
+
+// A spec info cannot read is refused as every command refuses it: one line naming it, exit 1,
+// nothing printed on stdout; a mistyped option is a usage error with the nearest name.
+TEST(CliInfo, RefusesABadSpecInOneLine) {
+  TempDir tmp;
+  std::ofstream(tmp.path() / "run.bag") << "never read";
+  const std::string bag = (tmp.path() / "run.bag").string();
+  Result r = run("info --dataset " + bag);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err, "semsegmap info: error: " + bag +
+                       ": a ROS 1 bag, not a dataset directory: write rosbag:" + bag + "\n");
+  EXPECT_EQ(r.out, "");
+  r = run("info --dataset folder:" + (tmp.path() / "none").string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("none: no such folder"), std::string::npos) << r.err;
+  r = run("info --datset " + bag);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown option --datset (did you mean --dataset?)"), std::string::npos)
+      << r.err;
 }
 
 // The commonest real rig as a user runs it: one front camera on a 360-degree HDL-64E (the real

@@ -104,6 +104,7 @@ const CommandSpec& demoCommand();
 const CommandSpec& enrichCommand();
 const CommandSpec& labelCommand();
 const CommandSpec& convertCommand();
+const CommandSpec& infoCommand();
 const CommandSpec& segmentCommand();
 const CommandSpec& mapCommand();
 const CommandSpec& localizeCommand();

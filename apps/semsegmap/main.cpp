@@ -27,8 +27,9 @@ const std::vector<const CommandSpec*>& commands() {
 #if SEMSEGMAP_WITH_SIM
     c = {&simulateCommand(), &simulateOverviewCommand()};
 #endif
-    c.insert(c.end(), {&enrichCommand(), &labelCommand(), &convertCommand(), &segmentCommand(),
-                       &mapCommand(), &localizeCommand(), &slamCommand(), &odometryCommand()});
+    c.insert(c.end(), {&infoCommand(), &enrichCommand(), &labelCommand(), &convertCommand(),
+                       &segmentCommand(), &mapCommand(), &localizeCommand(), &slamCommand(),
+                       &odometryCommand()});
 #if SEMSEGMAP_WITH_TORCH
     c.push_back(&trainCommand());
 #endif
@@ -177,7 +178,7 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
 }
 
 bool isOutput(const OptionSpec& o) {
-  return o.name == "out" || o.name == "ply" || o.name == "history" ||
+  return o.name == "out" || o.name == "ply" || o.name == "history" || o.name == "json" ||
          (o.name == "cameras" && o.placeholder == "FILE.png");
 }
 
