@@ -601,15 +601,16 @@ TEST(RunOutputs, AFailedRunRemovesWhatItCreatedAndNothingElse) {
   writeText(old_dir / "replaced.txt", "before");
   {
     RunOutputs outputs;
-    outputs.folder(old_dir);
-    outputs.folder(tmp.path() / "new" / "deep");
-    outputs.file(tmp.path() / "files" / "x.map");
-    EXPECT_TRUE(fs::is_directory(tmp.path() / "new" / "deep"));  // made up front
+    EXPECT_EQ(outputs.folder(old_dir), 3u);  // what it held before
+    EXPECT_EQ(outputs.folder(tmp.path() / "new"), 0u);
+    EXPECT_FALSE(outputs.file(tmp.path() / "x.map"));
+    EXPECT_TRUE(fs::is_directory(tmp.path() / "new"));  // made up front
     fs::create_directories(old_dir / "sub");
     writeBytesAtomically(old_dir / "sub" / "summary.json", "{}");
     writeBytesAtomically(old_dir / "replaced.txt", "after");
+    fs::create_directories(tmp.path() / "new" / "deep");
     writeBytesAtomically(tmp.path() / "new" / "deep" / "a.csv", "a");
-    writeBytesAtomically(tmp.path() / "files" / "x.map", "m");
+    writeBytesAtomically(tmp.path() / "x.map", "m");
     writeBytesAtomically(tmp.path() / "cache.bin", "outside the outputs: kept");
   }  // not committed: the command failed
   EXPECT_EQ(entriesOf(tmp.path()), (std::vector<std::string>{"cache.bin", "old", "old/kept_empty",
@@ -626,6 +627,25 @@ TEST(RunOutputs, ACommittedRunKeepsEverything) {
     outputs.commit();
   }
   EXPECT_TRUE(fs::exists(tmp.path() / "out" / "summary.json"));
+}
+
+// A missing folder above an output is a mistyped path: refused, never made.
+TEST(RunOutputs, AnOutputWhoseFolderIsMissingIsRefusedAndNothingIsMade) {
+  TempDir tmp;
+  writeText(tmp.path() / "there.map", "x");
+  RunOutputs outputs;
+  const fs::path missing = tmp.path() / "no" / "such";
+  expectError([&] { outputs.file(missing / "x.map", "--out"); },
+              {(missing / "x.map").string() + ": --out cannot be written: its folder " +
+               missing.string() + " does not exist"});
+  expectError([&] { outputs.folder(missing / "out", "--out"); },
+              {"its folder " + missing.string() + " does not exist"});
+  expectError([&] { outputs.keptFile(missing / "c.cache", "--cache"); },
+              {"--cache cannot be written"});
+  EXPECT_EQ(entriesOf(tmp.path()), (std::vector<std::string>{"there.map"}));
+  EXPECT_TRUE(outputs.file(tmp.path() / "there.map"));  // there before: replaced
+  EXPECT_EQ(outputs.folder(tmp.path() / "out/"), 0u);   // a trailing '/' names the folder
+  EXPECT_TRUE(fs::is_directory(tmp.path() / "out"));
 }
 
 TEST(RunOutputs, OutputsOfTheWrongKindAreRefusedBeforeAnythingIsMade) {

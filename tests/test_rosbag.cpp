@@ -876,6 +876,11 @@ TEST_P(Bags, RoundTripOfASyntheticRecording) {
   EXPECT_EQ(reader.cameraTopics(), std::vector<std::string>{"/cam/image_raw"});
   const auto& info = reader.info();
   EXPECT_TRUE(info.has_odometry);
+  // What `semsegmap info` shows of the reader's choices.
+  EXPECT_EQ(info.origin.lidar, "topic /velodyne_points, frame velodyne, base frame base_link");
+  EXPECT_EQ(info.origin.cameras,
+            std::vector<std::string>{"topic /cam/image_raw, /cam/camera_info, frame cam_optical"});
+  EXPECT_EQ(info.origin.odometry, "TF odom -> base_link");
   EXPECT_NEAR(info.rig.rate_hz, 10.0, 1e-3);  // stamps near 1.3e9 s carry ~1e-7 s rounding
   EXPECT_TRUE(info.rig.T_base_lidar.isApprox(rec.T_base_lidar, 1e-9));
   ASSERT_EQ(info.rig.cameras.size(), 1u);
@@ -941,6 +946,7 @@ TEST_P(Bags, OdometryTopicAndNoOdometry) {
     const fs::path bag = writeBag(GetParam(), dir.path(), msgs);
     RosbagReader reader(bag);
     EXPECT_FALSE(reader.info().has_odometry);  // no Odometry topic, no odom frame
+    EXPECT_EQ(reader.info().origin.odometry, "");
     EXPECT_EQ(reader.size(), 4u);
   }
   // The odometry of the LiDAR frame, moved to the base by TF.
@@ -952,6 +958,7 @@ TEST_P(Bags, OdometryTopicAndNoOdometry) {
   TempDir dir2;
   RosbagReader reader(writeBag(GetParam(), dir2.path(), msgs));
   ASSERT_TRUE(reader.info().has_odometry);
+  EXPECT_EQ(reader.info().origin.odometry, "topic /odom (nav_msgs/Odometry)");
   for (size_t f = 0; f < reader.size(); ++f)
     EXPECT_TRUE(reader.frame(f).T_odom_base.isApprox(Recording::odometry(rec.stamps[f]), 1e-6))
         << f;

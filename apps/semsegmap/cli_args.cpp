@@ -1,6 +1,7 @@
 #include "cli_args.h"
 
 #include "resources.h"
+#include "semsegmap/core/nearest_name.h"
 
 #include <algorithm>
 #include <cmath>
@@ -54,7 +55,7 @@ void checkValue(const OptionSpec& option, const std::string& text) {
   if (text.empty()) throw UsageError(what + " needs a value");
   const std::vector<std::string> choices = choicesOf(option);
   if (!choices.empty() && std::find(choices.begin(), choices.end(), text) == choices.end())
-    throw UsageError(what + " expects " + option.placeholder + got);
+    throw UsageError(what + " expects " + option.placeholder + got + didYouMean(text, choices));
   long long n = 0;
   double x = 0.0;
   switch (option.kind) {
@@ -138,6 +139,12 @@ void checkDefaults(const CommandSpec& command) {
 
 }  // namespace
 
+std::string didYouMean(const std::string& typed, const std::vector<std::string>& known,
+                       const std::string& prefix) {
+  const std::string nearest = nearestName(typed, known);
+  return nearest.empty() ? "" : " (did you mean " + prefix + nearest + "?)";
+}
+
 OptionSpec maxFramesOption(const std::string& help) {
   return {"max-frames", Value::kCount, "K", "0", help};
 }
@@ -195,13 +202,20 @@ std::string commandHelp(const CommandSpec& command) {
 CliArgs::CliArgs(const CommandSpec& command, const std::vector<std::string>& args)
     : command_(&command), args_(args) {
   checkDefaults(command);
+  std::vector<std::string> names = {"help"};  // for the hint after an unknown option
+  for (const OptionSpec& o : command.options) names.push_back(o.name);
   for (size_t k = 0; k < args.size(); ++k) {
     const std::string& a = args[k];
-    if (a.rfind("--", 0) != 0 || a.size() == 2) throw UsageError("unexpected argument '" + a + "'");
+    if (a.rfind("--", 0) != 0 || a.size() == 2) {
+      // "-odometry": an option with one dash.
+      const std::string hint =
+          a.size() > 1 && a[0] == '-' ? didYouMean(a.substr(1), names, "--") : "";
+      throw UsageError("unexpected argument '" + a + "'" + hint);
+    }
     const size_t eq = a.find('=');
     const std::string name = a.substr(2, eq == std::string::npos ? std::string::npos : eq - 2);
     const OptionSpec* option = findOption(command, name);
-    if (!option) throw UsageError("unknown option --" + name);
+    if (!option) throw UsageError("unknown option --" + name + didYouMean(name, names, "--"));
     if (values_.count(name)) throw UsageError("option --" + name + " given twice");
     if (option->kind == Value::kFlag) {
       if (eq != std::string::npos) throw UsageError("option --" + name + " takes no value");

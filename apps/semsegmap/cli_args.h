@@ -57,6 +57,11 @@ std::string commandHelp(const CommandSpec& command);
 // others in brackets) and its summary.
 std::string commandOverview(const std::vector<const CommandSpec*>& commands);
 
+// " (did you mean --odometry?)": the hint an error about an unknown `typed` name ends with when
+// it is a typo of one of `known` (core/nearest_name.h), each shown with `prefix`; else empty.
+std::string didYouMean(const std::string& typed, const std::vector<std::string>& known,
+                       const std::string& prefix = "");
+
 // Options shared by several commands.
 OptionSpec maxFramesOption(const std::string& help = "stop after the first K frames, 0: all");
 extern const char* const kDatasetNotes;  // the forms --dataset SPEC takes
@@ -99,6 +104,7 @@ const CommandSpec& demoCommand();
 const CommandSpec& enrichCommand();
 const CommandSpec& labelCommand();
 const CommandSpec& convertCommand();
+const CommandSpec& infoCommand();
 const CommandSpec& segmentCommand();
 const CommandSpec& mapCommand();
 const CommandSpec& localizeCommand();

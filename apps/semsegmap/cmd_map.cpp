@@ -54,7 +54,6 @@ int runMap(const CliArgs& a) {
     earlier = run.earlier_observations;
     duplicates = run.duplicates_removed;
   }
-  if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
   MapWriteOptions write;
   write.float16 = !a.has("float32");
   const uint64_t bytes = saveTargetMap(out, map, write);

@@ -220,7 +220,6 @@ int runTrain(const CliArgs& a) {
     pipeline = loadPipelineConfig(a.get("config"));
     config_text = readFileBytes(a.get("config"));
   }
-  if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
 
   const TrainingSet data =
       loadOrExtract(specs, pipeline, config_text, extraction, a.has("cache") ? a.get("cache") : "");

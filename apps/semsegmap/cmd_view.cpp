@@ -69,7 +69,6 @@ uint64_t writeViewPage(const ViewSources& s, const std::filesystem::path& out) {
   in.segments = segments ? &*segments : nullptr;
   in.colouring = s.colouring;
   const std::string page = viz::viewerPage(viewerPageTemplate(), viz::sceneJson(in));
-  if (!out.parent_path().empty()) std::filesystem::create_directories(out.parent_path());
   writeBytesAtomically(out, page);
   return page.size();
 }

@@ -30,8 +30,9 @@ const std::vector<const CommandSpec*>& commands() {
 #if SEMSEGMAP_WITH_SIM
     c = {&simulateCommand(), &simulateOverviewCommand()};
 #endif
-    c.insert(c.end(), {&enrichCommand(), &labelCommand(), &convertCommand(), &segmentCommand(),
-                       &mapCommand(), &localizeCommand(), &slamCommand(), &odometryCommand()});
+    c.insert(c.end(), {&infoCommand(), &enrichCommand(), &labelCommand(), &convertCommand(),
+                       &segmentCommand(), &mapCommand(), &localizeCommand(), &slamCommand(),
+                       &odometryCommand()});
 #if SEMSEGMAP_WITH_TORCH
     c.push_back(&trainCommand());
 #endif
@@ -138,6 +139,26 @@ bool asksForHelp(const std::vector<std::string>& args) {
   return false;
 }
 
+// The first words a command line may start with, for the hint after an unknown one: the
+// commands, those this build leaves out (which then say why), and the options of `semsegmap`
+// itself.
+std::vector<std::string> firstWords() {
+  std::vector<std::string> words = {"eval", "--help", "--version", "--check-usage"};
+  for (const CommandSpec* c : commands()) words.push_back(c->name);
+  for (const AbsentCommand& c : absentCommands())
+    if (c.name.find(' ') == std::string::npos) words.push_back(c.name);
+  return words;
+}
+
+// An unknown experiment: the nearest one when it looks like a typo, else the list.
+UsageError unknownExperiment(const std::string& typed) {
+  std::vector<std::string> experiments;
+  for (const CommandSpec* c : evalCommands()) experiments.push_back(c->name.substr(5));
+  const std::string hint = didYouMean(typed, experiments);
+  return UsageError("unknown experiment '" + typed + "'" +
+                    (hint.empty() ? " (expected " + experimentList() + ")" : hint));
+}
+
 // The command `args` names (one word, or two after `eval`); `name` is set to what was found so
 // far, for the error messages. Throws UsageError for an unknown one.
 const CommandSpec* findCommand(const std::vector<std::string>& args, std::string* name) {
@@ -146,7 +167,8 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
     *name = c->name;
     return c;
   }
-  if (args[0] != "eval") throw UsageError("unknown command '" + args[0] + "'");
+  if (args[0] != "eval")
+    throw UsageError("unknown command '" + args[0] + "'" + didYouMean(args[0], firstWords()));
   *name = "eval";
   if (args.size() < 2 || args[1].rfind("-", 0) == 0)
     throw UsageError("eval needs an experiment: " + experimentList());
@@ -155,21 +177,38 @@ const CommandSpec* findCommand(const std::vector<std::string>& args, std::string
     *name = c->name;
     return c;
   }
-  throw UsageError("unknown experiment '" + args[1] + "' (expected " + experimentList() + ")");
+  throw unknownExperiment(args[1]);
+}
+
+bool isOutput(const OptionSpec& o) {
+  return o.name == "out" || o.name == "ply" || o.name == "history" || o.name == "json" ||
+         (o.name == "cameras" && o.placeholder == "FILE.png");
+}
+
+// One line for an output that is there already: it is overwritten, the same rule for every
+// command, since runs are repeated into one folder (`make demo`, an evaluation after a change).
+std::string replacedNote(const std::string& option, const std::string& path, size_t entries,
+                         bool folder) {
+  if (!folder) return option + " " + path + " exists: this run replaces it";
+  return option + " " + path + " already holds " + std::to_string(entries) +
+         (entries == 1 ? " entry" : " entries") +
+         ": this run's files replace those of the same name, the others stay";
 }
 
 // What a command writes: --out and the options naming another file it writes; a DIR placeholder
-// says a folder. Checked before the command starts, removed again when it fails.
+// says a folder. Checked before the command starts, removed again when it fails; what is there
+// already is said, once every output passed its check.
 void declareOutputs(const CliArgs& a, RunOutputs& outputs) {
+  std::vector<std::string> replaced;
   for (const OptionSpec& o : a.command().options) {
-    const bool output = o.name == "out" || o.name == "ply" || o.name == "history" ||
-                        (o.name == "cameras" && o.placeholder == "FILE.png");
-    if (!output || (!a.has(o.name) && o.fallback.empty())) continue;
-    if (o.placeholder == "DIR")
-      outputs.folder(a.get(o.name), "--" + o.name);
-    else
-      outputs.file(a.get(o.name), "--" + o.name);
+    if (o.name == "cache" && a.has("cache")) outputs.keptFile(a.get("cache"), "--cache");
+    if (!isOutput(o) || (!a.has(o.name) && o.fallback.empty())) continue;
+    const std::string option = "--" + o.name, path = a.get(o.name);
+    const bool folder = o.placeholder == "DIR";
+    const size_t before = folder ? outputs.folder(path, option) : outputs.file(path, option);
+    if (before > 0) replaced.push_back(replacedNote(option, path, before, folder));
   }
+  for (const std::string& line : replaced) note(line);
 }
 
 int usageError(const std::string& name, const std::string& message) {

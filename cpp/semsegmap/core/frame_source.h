@@ -5,6 +5,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "semsegmap/core/class_table.h"
 #include "semsegmap/core/frame.h"
@@ -12,8 +13,22 @@
 
 namespace semsegmap {
 
+// Where a dataset's parts come from, in words, as `semsegmap info` shows them: the reader's
+// choices (a topic, a file pattern, a pose file and the rule that matched its poses). Empty where
+// the dataset has no such part.
+struct DatasetOrigin {
+  std::string kind;                  // how it was read: "rosbag", "folder", "kitti-raw", ...
+  std::string lidar;                 // "topic /points (frame velodyne)", "velodyne/*.bin"
+  std::vector<std::string> cameras;  // per rig camera, in its order: "topic /cam/image_raw"
+  std::string odometry;              // "topic /odom", "TF odom -> base_link", "poses.txt: ..."
+  std::string ground_truth;
+  std::string label_images;  // the cameras' class images: "cam0_label/", "label set DIR"
+  std::string point_labels;  // per-point classes: "labels/*.label"
+};
+
 struct DatasetInfo {
   std::string name;
+  DatasetOrigin origin;
   SensorRig rig;
   ClassTable classes = ClassTable::Default();
   bool has_ground_truth_poses = false;

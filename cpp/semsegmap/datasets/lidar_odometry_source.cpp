@@ -14,6 +14,7 @@ class LidarOdometrySource : public FrameSource {
       : source_(std::move(source)), odometry_(config), info_(source_->info()) {
     info_.has_odometry = true;
     info_.odometry_is_ground_truth = false;
+    info_.origin.odometry = "LiDAR odometry on the scans";
     T_base_lidar_ = info_.rig.T_base_lidar;
   }
 

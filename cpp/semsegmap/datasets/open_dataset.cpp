@@ -5,9 +5,11 @@
 #include <stdexcept>
 
 #include "semsegmap/core/diagnostics.h"
+#include "semsegmap/core/nearest_name.h"
 #include "semsegmap/datasets/lidar_odometry_source.h"
 #include "semsegmap/datasets/pose_files.h"
 #include "semsegmap/datasets/semantic_sources.h"
+#include "semsegmap/datasets/spec_guess.h"
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/folder_reader.h"
 #if SEMSEGMAP_WITH_ROS
@@ -153,6 +155,33 @@ std::unique_ptr<FrameSource> openRosbag(const std::string& spec, const std::stri
 }
 #endif
 
+std::invalid_argument unknownKind(const std::string& spec, const std::string& kind) {
+  const std::string nearest =
+      nearestName(kind, {"kitti-raw", "semantickitti", "nclt", "sim", "folder", "rosbag"});
+  return std::invalid_argument(
+      "dataset '" + spec + "': unknown kind '" + kind + "' " +
+      (nearest.empty()
+           ? "(expected kitti-raw:, semantickitti:, nclt:, sim:, folder:, rosbag: or a directory)"
+           : "(did you mean " + nearest + ":?)"));
+}
+
+// A spec without a kind that is no dataset directory: what it looks like and what to write
+// instead, when that can be told cheaply (datasets/spec_guess.h).
+std::runtime_error notADatasetDirectory(const std::string& spec) {
+  if (const auto guess = guessDatasetSpec(spec)) {
+    const bool folder = std::filesystem::is_directory(spec);
+    return std::runtime_error(spec + ": " + guess->what + ", not a dataset directory" +
+                              (folder ? " of the project's format" : "") + ": write " +
+                              guess->spec);
+  }
+  if (std::filesystem::exists(spec))
+    return std::runtime_error(
+        spec +
+        ": a file, not a dataset directory (a dataset is a directory, or "
+        "KIND:PATH with kitti-raw:, semantickitti:, nclt:, folder:, rosbag:)");
+  return std::runtime_error(spec + ": no such dataset directory");
+}
+
 std::unique_ptr<FrameSource> openSource(const std::string& spec, const DatasetOptions& options) {
   const auto colon = spec.find(':');
   if (colon != std::string::npos) {
@@ -164,14 +193,12 @@ std::unique_ptr<FrameSource> openSource(const std::string& spec, const DatasetOp
     if (kind == "folder") return openFolder(spec, rest, options);
     if (kind == "rosbag") return openRosbag(spec, rest);
     // Anything else with a colon may still be a directory name.
-    if (!std::filesystem::exists(spec))
-      throw std::invalid_argument(
-          "dataset '" + spec + "': unknown kind '" + kind +
-          "' (expected kitti-raw:, semantickitti:, nclt:, sim:, folder:, rosbag: or a directory)");
+    if (!std::filesystem::exists(spec)) throw unknownKind(spec, kind);
   }
-  if (!std::filesystem::is_directory(spec))
-    throw std::runtime_error(spec + ": no such dataset directory");
+  if (!std::filesystem::is_directory(spec)) throw notADatasetDirectory(spec);
   if (!std::filesystem::exists(std::filesystem::path(spec) / "meta.yaml")) {
+    // A KITTI raw drive, a bag folder...: read as a folder of scans it would fail on no scans.
+    if (guessDatasetSpec(spec)) throw notADatasetDirectory(spec);
     note(spec + " has no meta.yaml: reading it as folder:" + spec);
     return openFolder("folder:" + spec, spec, options);
   }

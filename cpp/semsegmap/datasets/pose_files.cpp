@@ -17,12 +17,13 @@ namespace fs = std::filesystem;
 namespace {
 
 // KITTI poses of camera 0 become LiDAR poses when a calibration says how (see PoseFileOptions).
-void applyKittiCalib(const fs::path& poses_path, const fs::path& explicit_calib,
-                     const Pose& T_base_lidar, std::vector<StampedPose>& poses) {
+// Returns the calibration used, or nothing.
+fs::path applyKittiCalib(const fs::path& poses_path, const fs::path& explicit_calib,
+                         const Pose& T_base_lidar, std::vector<StampedPose>& poses) {
   fs::path calib = explicit_calib;
   if (calib.empty()) {
     const fs::path beside = poses_path.parent_path() / "calib.txt";
-    if (!fs::exists(beside) || !KittiCalibFile(beside).has("Tr")) return;
+    if (!fs::exists(beside) || !KittiCalibFile(beside).has("Tr")) return {};
     calib = beside;
     note(poses_path.string() + ": KITTI camera-0 poses, turned into LiDAR poses with Tr from " +
          calib.string() + " (--kitti-calib FILE to choose)");
@@ -34,6 +35,7 @@ void applyKittiCalib(const fs::path& poses_path, const fs::path& explicit_calib,
   // The files hold base poses: the LiDAR poses moved onto the base the rig mounts them on.
   const Pose T_lidar_base = T_base_lidar.inverse();
   for (size_t i = 0; i < poses.size(); ++i) poses[i].T = T_base_lidar * lidar[i] * T_lidar_base;
+  return calib;
 }
 
 using PerFrame = std::vector<std::optional<Pose>>;
@@ -51,8 +53,9 @@ std::vector<size_t> frameNumbersOf(FrameSource& source) {
 
 // KITTI poses have no times: line N is the pose of the scan numbered N. Scans named otherwise
 // take the lines in order only when there is one line per scan; any other count is a guess.
+// `rule` is set to the rule used.
 PerFrame kittiPosesPerFrame(FrameSource& source, const fs::path& path,
-                            const std::vector<StampedPose>& poses) {
+                            const std::vector<StampedPose>& poses, std::string* rule) {
   const std::vector<size_t> numbers = frameNumbersOf(source);
   PerFrame per_frame(source.size());
   if (!numbers.empty()) {
@@ -62,6 +65,7 @@ PerFrame kittiPosesPerFrame(FrameSource& source, const fs::path& path,
                                " KITTI poses, but the scans go up to frame " +
                                std::to_string(last) + " (line N is the pose of the scan named N)");
     for (size_t i = 0; i < numbers.size(); ++i) per_frame[i] = poses[numbers[i]].T;
+    *rule = "KITTI poses matched by frame number";
     note(path.string() + ": KITTI poses matched by frame number: line N is the pose of the scan " +
          "named N (" + std::to_string(numbers.size()) + " scans, frames " +
          std::to_string(numbers.front()) + " to " + std::to_string(last) + ")");
@@ -74,6 +78,7 @@ PerFrame kittiPosesPerFrame(FrameSource& source, const fs::path& path,
                              "scan's would be a guess (name the scans by frame number, or give "
                              "TUM poses)");
   for (size_t i = 0; i < poses.size(); ++i) per_frame[i] = poses[i].T;
+  *rule = "KITTI poses taken in scan order, one line per scan";
   note(path.string() + ": KITTI poses taken in scan order, one line per scan (the " +
        std::to_string(poses.size()) + " scans' names are no frame numbers)");
   return per_frame;
@@ -81,7 +86,8 @@ PerFrame kittiPosesPerFrame(FrameSource& source, const fs::path& path,
 
 // TUM poses are interpolated to each scan's time, which must then come from the data.
 PerFrame tumPosesPerFrame(FrameSource& source, const fs::path& path,
-                          const std::vector<StampedPose>& poses, double max_gap_s) {
+                          const std::vector<StampedPose>& poses, double max_gap_s,
+                          std::string* rule) {
   if (!source.info().has_frame_times)
     throw std::runtime_error(path.string() + ": TUM poses are matched to scans by time, but the " +
                              "scans of " + source.info().name +
@@ -90,16 +96,27 @@ PerFrame tumPosesPerFrame(FrameSource& source, const fs::path& path,
   PerFrame per_frame(source.size());
   for (size_t i = 0; i < source.size(); ++i)
     per_frame[i] = poseAt(poses, source.frameTime(i), max_gap_s);
+  *rule = "TUM poses matched by time";
   note(path.string() + ": TUM poses matched by time, interpolated to each scan's time");
   return per_frame;
 }
 
-// Per frame of the source, its pose from the file, or nothing.
-PerFrame posesPerFrame(FrameSource& source, const fs::path& path, const PoseFileOptions& options) {
+// Per frame of the source, its pose from the file, or nothing; `origin` says which file and rule.
+PerFrame posesPerFrame(FrameSource& source, const fs::path& path, const PoseFileOptions& options,
+                       std::string* origin) {
   PoseFile file = readPoseFile(path);
-  if (file.timestamped) return tumPosesPerFrame(source, path, file.poses, options.max_gap_s);
-  applyKittiCalib(path, options.kitti_calib, source.info().rig.T_base_lidar, file.poses);
-  return kittiPosesPerFrame(source, path, file.poses);
+  std::string rule;
+  PerFrame poses;
+  if (file.timestamped) {
+    poses = tumPosesPerFrame(source, path, file.poses, options.max_gap_s, &rule);
+  } else {
+    const fs::path calib =
+        applyKittiCalib(path, options.kitti_calib, source.info().rig.T_base_lidar, file.poses);
+    poses = kittiPosesPerFrame(source, path, file.poses, &rule);
+    if (!calib.empty()) rule += ", camera 0 moved onto the LiDAR by Tr of " + calib.string();
+  }
+  *origin = path.string() + " (" + rule + ")";
+  return poses;
 }
 
 bool sameFile(const fs::path& a, const fs::path& b) {
@@ -112,8 +129,10 @@ class PosedSource : public FrameSource {
   PosedSource(std::unique_ptr<FrameSource> source, const PoseFileOptions& options)
       : source_(std::move(source)), info_(source_->info()) {
     std::vector<std::optional<Pose>> odom, gt;
-    if (!options.odometry.empty()) odom = posesPerFrame(*source_, options.odometry, options);
-    if (!options.ground_truth.empty()) gt = posesPerFrame(*source_, options.ground_truth, options);
+    if (!options.odometry.empty())
+      odom = posesPerFrame(*source_, options.odometry, options, &info_.origin.odometry);
+    if (!options.ground_truth.empty())
+      gt = posesPerFrame(*source_, options.ground_truth, options, &info_.origin.ground_truth);
     for (size_t i = 0; i < source_->size(); ++i) {
       if ((!odom.empty() && !odom[i]) || (!gt.empty() && !gt[i])) continue;
       kept_.push_back(

@@ -12,22 +12,29 @@ namespace semsegmap {
 namespace {
 
 // A source that passes frames through and changes their label images.
+// `labels` says where the label images come from now (DatasetOrigin::label_images).
 class RelabelledSource : public FrameSource {
  public:
-  explicit RelabelledSource(std::unique_ptr<FrameSource> source) : source_(std::move(source)) {}
-  const DatasetInfo& info() const override { return source_->info(); }
+  RelabelledSource(std::unique_ptr<FrameSource> source, const std::string& labels)
+      : source_(std::move(source)), info_(source_->info()) {
+    info_.origin.label_images = labels;
+  }
+  const DatasetInfo& info() const override { return info_; }
   size_t size() const override { return source_->size(); }
   double frameTime(size_t index) override { return source_->frameTime(index); }
   std::optional<size_t> frameNumber(size_t index) override { return source_->frameNumber(index); }
 
  protected:
   std::unique_ptr<FrameSource> source_;
+  DatasetInfo info_;
 };
 
 class LabelSetSource : public RelabelledSource {
  public:
   LabelSetSource(std::unique_ptr<FrameSource> source, std::filesystem::path dir, ClassMap map)
-      : RelabelledSource(std::move(source)), dir_(std::move(dir)), map_(std::move(map)) {}
+      : RelabelledSource(std::move(source), "label set " + dir.string()),
+        dir_(std::move(dir)),
+        map_(std::move(map)) {}
 
   Frame frame(size_t index) override {
     Frame f = source_->frame(index);
@@ -60,7 +67,12 @@ class LabelSetSource : public RelabelledSource {
 class NetworkSource : public RelabelledSource {
  public:
   NetworkSource(std::unique_ptr<FrameSource> source, std::shared_ptr<SegmentationNetwork> network)
-      : RelabelledSource(std::move(source)), labeler_(std::move(network)) {}
+      : RelabelledSource(std::move(source), "the semantics: network"),
+        labeler_(std::move(network)) {
+    // The network labels the pictures that have no label image of their own.
+    const std::string& own = source_->info().origin.label_images;
+    if (!own.empty()) info_.origin.label_images = own + ", else the semantics: network";
+  }
 
   Frame frame(size_t index) override {
     Frame f = source_->frame(index);

@@ -146,12 +146,29 @@ DatasetReader::DatasetReader(const fs::path& dir, size_t frames_to_check)
     rgb_dirs_.push_back(fs::is_directory(dir_ / ("cam" + std::to_string(k))));
     label_dirs_.push_back(fs::is_directory(dir_ / ("cam" + std::to_string(k) + "_label")));
   }
+  describeOrigin();
   requireFile(csv_);
   if (fs::is_directory(csv_)) throw std::runtime_error(csv_.string() + ": is a directory");
   file_.reset(std::fopen(csv_.c_str(), "rb"));
   if (!file_)
     throw std::runtime_error(csv_.string() + ": cannot open (" + std::strerror(errno) + ")");
   index(frames_to_check);
+}
+
+void DatasetReader::describeOrigin() {
+  DatasetOrigin& o = info_.origin;
+  o.kind = "dataset directory";
+  o.lidar = "lidar/NNNNNN.bin";
+  std::string label_dirs;
+  for (size_t k = 0; k < info_.rig.cameras.size(); ++k) {
+    const std::string cam = "cam" + std::to_string(k);
+    o.cameras.push_back(rgb_dirs_[k] ? cam + "/NNNNNN.png" : "no pictures");
+    if (label_dirs_[k]) label_dirs += (label_dirs.empty() ? "" : ", ") + cam + "_label/";
+  }
+  o.label_images = label_dirs;
+  if (info_.has_odometry) o.odometry = "frames.csv (odom_ columns)";
+  if (info_.has_ground_truth_poses) o.ground_truth = "frames.csv (gt_ columns)";
+  if (info_.has_point_labels) o.point_labels = "lidar_gt/NNNNNN.bin";
 }
 
 // One pass over frames.csv: the header, then per row its field count and increasing index; the

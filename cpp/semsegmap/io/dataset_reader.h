@@ -39,6 +39,7 @@ class DatasetReader : public FrameSource {
     uint64_t offset;
     size_t line;
   };
+  void describeOrigin();  // info_.origin, from meta.yaml and the folders present
   void index(size_t frames_to_check);
   [[noreturn]] void rowError(const std::string& line, size_t line_number, bool have_previous,
                              size_t previous) const;

@@ -210,6 +210,29 @@ FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : 
   pictures_.resize(info_.rig.cameras.size());
   for (size_t c = 0; c < info_.rig.cameras.size(); ++c)
     pairPictures(c, dir_ / rig.camera_folders[c]);
+  describeOrigin(rig_path, lidar_dir, times_path);
+}
+
+// What `semsegmap info` shows: the rig file, the scans' pattern and where their times come from.
+void FolderReader::describeOrigin(const fs::path& rig, const fs::path& lidar_dir,
+                                  const fs::path& times) {
+  DatasetOrigin& o = info_.origin;
+  o.kind = rig.empty() ? "folder, no rig file (a LiDAR alone)" : "folder, rig " + rig.string();
+  std::vector<std::string> extensions;
+  for (const fs::path& scan : scans_)
+    if (std::find(extensions.begin(), extensions.end(), scan.extension().string()) ==
+        extensions.end())
+      extensions.push_back(scan.extension().string());
+  o.lidar = (lidar_dir / "*").string();
+  for (size_t k = 0; k < extensions.size(); ++k) o.lidar += (k == 0 ? "" : "|") + extensions[k];
+  o.lidar += !times.empty()          ? ", times from " + times.string()
+             : info_.has_frame_times ? ", times from the names"
+                                     : ", no times (made up from the rate)";
+  for (size_t c = 0; c < info_.rig.cameras.size(); ++c) {
+    const fs::path& first = *std::find_if(pictures_[c].begin(), pictures_[c].end(),
+                                          [](const fs::path& p) { return !p.empty(); });
+    o.cameras.push_back((first.parent_path() / "*").string() + first.extension().string());
+  }
 }
 
 // Scans without times in their names or a times file: scan N at N periods when the names are

@@ -54,6 +54,8 @@ class FolderReader : public FrameSource {
  private:
   void pairPictures(size_t camera, const std::filesystem::path& folder);
   void madeUpTimes(const std::filesystem::path& lidar_dir);
+  void describeOrigin(const std::filesystem::path& rig, const std::filesystem::path& lidar_dir,
+                      const std::filesystem::path& times);
 
   std::filesystem::path dir_;
   DatasetInfo info_;

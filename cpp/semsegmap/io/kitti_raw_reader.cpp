@@ -144,6 +144,10 @@ KittiRawReader::KittiRawReader(const fs::path& drive_dir) : dir_(normalizedDir(d
     frames_.push_back(f);
   }
 
+  info_.origin.kind = "kitti-raw";
+  info_.origin.lidar = "velodyne_points/data/*.bin";
+  info_.origin.cameras = {"image_02/data/*.png, calibration " + cam_to_cam_path_.string()};
+  if (has_oxts_) info_.origin.odometry = info_.origin.ground_truth = "oxts/data (GPS/INS)";
   info_.has_ground_truth_poses = has_oxts_;
   info_.has_odometry = has_oxts_;  // the oxts poses serve as odometry too
   info_.odometry_is_ground_truth = has_oxts_;

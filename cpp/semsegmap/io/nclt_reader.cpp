@@ -182,6 +182,10 @@ NcltReader::NcltReader(const fs::path& session_dir)
   info_.rig.T_base_lidar = F;  // LiDAR frame = NED body frame; base = its z-up version
   info_.rig.rate_hz = 10.0;
   info_.classes = ClassTable::Default();
+  info_.origin.kind = "nclt";
+  info_.origin.lidar = "velodyne_sync/*.bin";
+  if (!gt.empty())
+    info_.origin.odometry = info_.origin.ground_truth = gt_files[0].filename().string();
   info_.has_ground_truth_poses = !gt.empty();
   info_.has_odometry = !gt.empty();  // the ground truth serves as odometry too
   info_.odometry_is_ground_truth = !gt.empty();

@@ -128,9 +128,12 @@ RosbagReader::RosbagReader(const std::filesystem::path& bag, RosbagOptions optio
     : path_(bag), options_(std::move(options)), tf_(std::make_unique<rosmsg::TfBuffer>()) {
   bag_ = rosmsg::openBagStorage(bag);
   info_.name = "rosbag:" + bag.filename().string();
+  info_.origin.kind = "rosbag";
   chooseLidar();
   readTransforms();
   findBaseFrame();
+  info_.origin.lidar =
+      "topic " + lidar_topic_ + ", frame " + lidar_frame_ + ", base frame " + base_frame_;
   chooseCameras();
   findOdometry();
   describeLidar();
@@ -310,6 +313,7 @@ void RosbagReader::addCamera(const std::string& topic) {
   if (!T) fail("camera " + topic + ": " + why);
   cam.T_camera_lidar = *T;
   info_.rig.cameras.push_back(cam);
+  info_.origin.cameras.push_back("topic " + topic + ", " + info_topic + ", frame " + frame);
   cameras_.push_back(std::move(c));
 }
 
@@ -378,13 +382,16 @@ void RosbagReader::findOdometry() {
   const std::string odom_frame = rosmsg::tfFrameName(options_.odom_frame);
   if (!topic.empty()) {
     poses = odometryFromTopic(topic);
+    info_.origin.odometry = "topic " + topic + " (nav_msgs/Odometry)";
   } else if (tf_->hasFrame(odom_frame)) {
     for (size_t i = 0; i < stamps.size(); ++i)
       poses[i] = tf_->lookup(odom_frame, base_frame_, stamps[i]);
+    info_.origin.odometry = "TF " + odom_frame + " -> " + base_frame_;
   }
   info_.has_odometry =
       std::any_of(poses.begin(), poses.end(), [](const auto& p) { return p.has_value(); });
   if (!info_.has_odometry) {
+    info_.origin.odometry.clear();
     if (!topic.empty()) fail("odometry " + topic + " covers none of the LiDAR scans' times");
     note("no nav_msgs/Odometry topic and no TF chain '" + odom_frame + "' -> '" + base_frame_ +
          "': the bag has no odometry");

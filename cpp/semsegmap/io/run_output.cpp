@@ -168,8 +168,19 @@ bool inside(const fs::path& path, const fs::path& dir) {
   return !rel.empty() && rel != "." && *rel.begin() != "..";
 }
 
+// Absolute, without a trailing separator ("out/" is the folder out, whose parent is ".").
 fs::path normalized(const fs::path& path) {
-  return fs::absolute(path).lexically_normal();
+  fs::path p = fs::absolute(path).lexically_normal();
+  if (p.filename().empty() && p.has_relative_path()) p = p.parent_path();
+  return p;
+}
+
+// The folder an output goes into as the user wrote it ("maps" for maps/s0.map), or absolute
+// when they wrote none.
+fs::path shownParent(const fs::path& shown, const fs::path& full) {
+  fs::path p = shown;
+  if (p.filename().empty()) p = p.parent_path();
+  return p.has_parent_path() ? p.parent_path() : full.parent_path();
 }
 
 }  // namespace
@@ -186,50 +197,65 @@ RunOutputs::~RunOutputs() {
   if (!committed_) removeCreated();
 }
 
-void RunOutputs::makeFolder(const fs::path& dir, const fs::path& shown, const std::string& what) {
-  const fs::path full = normalized(dir);
-  const fs::path ancestor = nearestExisting(full);
+// The folder an output goes into must be there: a mistyped path (`--out /nonexistent/dir/x`)
+// would otherwise make a tree of folders in the wrong place without a word.
+void RunOutputs::requireParent(const fs::path& full, const fs::path& shown,
+                               const std::string& what) {
+  const fs::path parent = full.parent_path();
   std::error_code ec;
+  if (fs::is_directory(parent, ec)) {
+    requireWritableDirectory(parent, shown, what);
+    return;
+  }
+  const fs::path ancestor = nearestExisting(parent);
   if (!fs::is_directory(ancestor, ec))
     refuse(shown, what, "cannot be created: " + ancestor.string() + " is not a directory");
-  requireWritableDirectory(ancestor, shown, what);
-  if (ancestor == full) return;
-  // The topmost folder made: removing it removes everything the run put below it.
-  fs::path top = full;
-  while (top.parent_path() != ancestor) top = top.parent_path();
-  fs::create_directories(full, ec);
-  if (ec) refuse(shown, what, "cannot be created: " + ec.message());
-  created_.push_back(top);
+  refuse(shown, what,
+         "cannot be written: its folder " + shownParent(shown, full).string() +
+             " does not exist (create it first, or choose another)");
 }
 
-void RunOutputs::folder(const fs::path& dir, const std::string& what) {
+size_t RunOutputs::folder(const fs::path& dir, const std::string& what) {
   const fs::path full = normalized(dir);
   std::error_code ec;
   if (fs::exists(full, ec) && !fs::is_directory(full, ec))
     refuse(dir, what, "exists and is not a directory");
   if (!fs::exists(full, ec)) {
-    makeFolder(full, dir, what);
-    return;
+    requireParent(full, dir, what);
+    fs::create_directory(full, ec);
+    if (ec) refuse(dir, what, "cannot be created: " + ec.message());
+    created_.push_back(full);
+    return 0;
   }
   requireWritableDirectory(full, dir, what);
   existing_.push_back(full);
-  size_t listed = 0;
+  size_t listed = 0, entries = 0;
   for (auto it = fs::recursive_directory_iterator(full, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    entries += it.depth() == 0;
     if (++listed > kMaxListedFolders) {
       listed_all_ = false;
       break;
     }
     if (it->is_directory(ec)) old_dirs_.push_back(normalized(it->path()));
   }
+  return entries;
 }
 
-void RunOutputs::file(const fs::path& file, const std::string& what) {
+bool RunOutputs::file(const fs::path& file, const std::string& what) {
   const fs::path full = normalized(file);
   std::error_code ec;
   if (fs::is_directory(full, ec)) refuse(file, what, "is a directory, expected a file");
-  makeFolder(full.parent_path(), file, what);
-  if (!fs::exists(full, ec)) files_.push_back(full);
+  requireParent(full, file, what);
+  if (fs::exists(full, ec)) return true;
+  files_.push_back(full);
+  return false;
+}
+
+void RunOutputs::keptFile(const fs::path& file, const std::string& what) {
+  std::error_code ec;
+  if (fs::is_directory(normalized(file), ec)) refuse(file, what, "is a directory, expected a file");
+  requireParent(normalized(file), file, what);
 }
 
 bool RunOutputs::newFolder(const fs::path& dir) const {

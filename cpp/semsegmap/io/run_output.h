@@ -44,11 +44,12 @@ std::optional<SlamErrors> slamErrors(const SlamRun& run);
 // summary.json of a SLAM run: counts, speed and, with ground truth, the errors (slamErrors).
 std::string slamSummaryJson(const SlamRun& run, const std::string& dataset);
 
-// The outputs of one command. Declared before any work, each is checked at once: an output
-// folder must be a writable directory or creatable (its nearest existing ancestor a writable
-// directory), an output file must not be a directory and its folder likewise; the folders are
-// created then. Unless commit() is called (the command succeeded), the destructor removes what
-// the command created: folders that did not exist, and the files written atomically
+// The outputs of one command. Declared before any work, each is checked at once: the folder an
+// output goes into must exist and be writable (a missing one is refused, never made: a mistyped
+// path would grow a tree of folders in the wrong place), an output folder may itself be new (it
+// is created then) or an existing writable directory, an output file must not be a directory.
+// Unless commit() is called (the command succeeded), the destructor removes what the command
+// created: the output folders that did not exist, and the files written atomically
 // (core/atomic_file.h) into a folder that did, with the subfolders that held only them. Nothing
 // that existed before is removed (a file the run replaced keeps its new content), so a failed run
 // leaves no summary of its own behind. One RunOutputs at a time per process.
@@ -60,20 +61,26 @@ class RunOutputs {
   RunOutputs& operator=(const RunOutputs&) = delete;
 
   // Throw std::runtime_error "<path>: <what is wrong>" (`what` names the option, e.g. "--out").
-  void folder(const std::filesystem::path& dir, const std::string& what = "output folder");
-  void file(const std::filesystem::path& file, const std::string& what = "output file");
+  // folder(): how many entries the folder held before (0 for a new one); file(): whether the
+  // file was there before. What the run writes replaces what has the same name.
+  size_t folder(const std::filesystem::path& dir, const std::string& what = "output folder");
+  bool file(const std::filesystem::path& file, const std::string& what = "output file");
+  // A file the command writes and keeps even when it fails (a cache of work done): checked as
+  // file() checks, never removed.
+  void keptFile(const std::filesystem::path& file, const std::string& what);
   void commit() { committed_ = true; }
 
  private:
-  // Creates `dir` and its missing ancestors; errors name `shown`, the output as given.
-  void makeFolder(const std::filesystem::path& dir, const std::filesystem::path& shown,
-                  const std::string& what);
+  // Refuses `full` unless its folder exists and is writable; errors name `shown`, the output
+  // as given.
+  static void requireParent(const std::filesystem::path& full, const std::filesystem::path& shown,
+                            const std::string& what);
   bool owns(const std::filesystem::path& path) const;
   // Inside an existing output folder and made by this run.
   bool newFolder(const std::filesystem::path& dir) const;
   void removeCreated() noexcept;
 
-  std::vector<std::filesystem::path> created_;   // the topmost folders this run made
+  std::vector<std::filesystem::path> created_;   // the output folders this run made
   std::vector<std::filesystem::path> existing_;  // declared folders that were there before
   std::vector<std::filesystem::path> files_;     // declared files that were not
   std::vector<std::filesystem::path> written_;   // new files the run wrote (the observer)

@@ -151,6 +151,12 @@ SemanticKittiReader::SemanticKittiReader(const fs::path& sequence_dir)
     }
   }
   info_.classes = ClassTable::Default();
+  info_.origin.kind = "semantickitti";
+  info_.origin.lidar = "velodyne/*.bin";
+  if (has_images) info_.origin.cameras = {"image_2/*.png, calibration calib.txt (P2, Tr)"};
+  if (has_poses)
+    info_.origin.odometry = info_.origin.ground_truth = "poses.txt (camera 0, moved by Tr)";
+  if (has_labels) info_.origin.point_labels = "labels/*.label";
   info_.has_ground_truth_poses = has_poses;
   info_.has_odometry = has_poses;  // the poses serve as odometry too
   info_.odometry_is_ground_truth = has_poses;

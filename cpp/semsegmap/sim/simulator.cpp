@@ -59,6 +59,16 @@ Simulator::Simulator(const SimConfig& config)
   info_.has_point_labels = true;
   info_.point_labels_have_classes = config_.point_classes;
   info_.first_transient_instance = kTrafficInstanceBase;
+  info_.origin.kind = "sim";
+  info_.origin.lidar = "rendered, " + std::to_string(info_.rig.lidar.columns) + " x " +
+                       std::to_string(info_.rig.lidar.rows) + " beams";
+  info_.origin.cameras.assign(info_.rig.cameras.size(), "rendered");
+  info_.origin.odometry = "the simulator's drifting odometry";
+  info_.origin.ground_truth = "the simulator's poses";
+  if (!info_.rig.cameras.empty())
+    info_.origin.label_images = config_.label_noise > 0 ? "rendered, with label noise" : "rendered";
+  info_.origin.point_labels =
+      config_.point_classes ? "the simulator's" : "the simulator's instances, no classes";
 }
 
 Simulator::~Simulator() = default;
@@ -101,6 +111,11 @@ LidarScan Simulator::sweepLidar(size_t index, uint64_t seed) const {
     poses[c] = baseAt(trajectory_, index, times[c]) * config_.rig.T_base_lidar;
   }
   return simulateLidarSweep(*scene_, lidar, poses, times, seed);
+}
+
+double Simulator::frameTime(size_t index) {
+  if (index >= size()) throwFrameOutOfRange(info_.name, index, size());
+  return trajectory_.timestamps_s[index];
 }
 
 Frame Simulator::frame(size_t index) {

@@ -53,6 +53,7 @@ class Simulator : public FrameSource {
   const DatasetInfo& info() const override { return info_; }
   size_t size() const override;
   Frame frame(size_t index) override;
+  double frameTime(size_t index) override;  // from the trajectory, without rendering
 
   const World& world() const { return *world_; }
   const Trajectory& trajectory() const { return trajectory_; }
