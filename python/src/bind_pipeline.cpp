@@ -296,6 +296,7 @@ void bindLocalizationResults(py::module_& m) {
                     "localized by the latest scan's own segments (latest_scan_fallback_m)");
   py::class_<LocalizationSummary>(m, "LocalizationSummary")
       .def_readonly("localizations", &LocalizationSummary::localizations)
+      .def_readonly("with_ground_truth", &LocalizationSummary::with_ground_truth)
       .def_readonly("below_1m", &LocalizationSummary::below_1m)
       .def_readonly("below_5m", &LocalizationSummary::below_5m)
       .def_readonly("mean_translation_error_m", &LocalizationSummary::mean_translation_error_m)
@@ -309,8 +310,10 @@ void bindLocalizationResults(py::module_& m) {
       .def_readonly("distance_m", &LocalizationRun::distance_m)
       .def_readonly("odometry_is_ground_truth", &LocalizationRun::odometry_is_ground_truth)
       .def_readonly("stats", &LocalizationRun::stats)
-      .def("summary", [](const LocalizationRun& r) { return summarize(r.localizations); });
-  m.def("summarize", &summarize, py::arg("records"));
+      .def("summary", [](const LocalizationRun& r) { return summarize(r); });
+  m.def("summarize",
+        static_cast<LocalizationSummary (*)(const std::vector<LocalizationRecord>&)>(&summarize),
+        py::arg("records"));
 }
 
 void bindLocalization(py::module_& m) {

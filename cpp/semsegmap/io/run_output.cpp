@@ -62,7 +62,7 @@ nlohmann::ordered_json stageMsJson(const StageTimes& t, bool with_total) {
 }
 
 std::string localizationSummaryJson(const LocalizationRun& run, const SummaryContext& c) {
-  const LocalizationSummary s = summarize(run.localizations);
+  const LocalizationSummary s = summarize(run);
   nlohmann::ordered_json j;
   j["dataset"] = c.dataset;
   j["map"] = c.map;
@@ -74,16 +74,14 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   // The errors below measured against the very poses the local map was built on.
   j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
   j["n_localizations"] = s.localizations;
-  j["n_error_below_1m"] = s.below_1m;
-  j["n_error_below_5m"] = s.below_5m;
+  j["n_with_ground_truth"] = s.with_ground_truth;
+  // Without ground truth (or without a localization) the errors are unknown: null, not zero.
+  j["n_error_below_1m"] = orNull(s.below_1m);
+  j["n_error_below_5m"] = orNull(s.below_5m);
   j["n_refined"] = std::count_if(run.localizations.begin(), run.localizations.end(),
                                  [](const LocalizationRecord& r) { return r.refined; });
-  // No localization, or no ground truth: the errors are unknown, not zero (which reads as perfect).
-  const bool errors_known = s.localizations > 0 && !run.trajectory_gt.empty();
-  j["mean_translation_error_m"] =
-      errors_known ? nlohmann::ordered_json(s.mean_translation_error_m) : nullptr;
-  j["mean_rotation_error_deg"] =
-      errors_known ? nlohmann::ordered_json(s.mean_rotation_error_deg) : nullptr;
+  j["mean_translation_error_m"] = orNull(s.mean_translation_error_m);
+  j["mean_rotation_error_deg"] = orNull(s.mean_rotation_error_deg);
   j["fps"] = run.stats.fps();
   j["stage_ms"] = stageMsJson(meanStageTimes(run.stats), true);
   j["map_segments"] = c.map_segments;
@@ -123,12 +121,14 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
   j["fps"] = run.stats.fps();
   j["graph_ms_total"] = run.graph_ms;
   const std::optional<SlamErrors> errors = slamErrors(run);
-  if (errors) {
-    j["ate_odometry"] = errorJson(errors->odometry);
-    j["ate_slam"] = errorJson(errors->slam);
-    j["ate_odometry_aligned"] = errorJson(errors->odometry_aligned);
-    j["ate_slam_aligned"] = errorJson(errors->slam_aligned);
-  }
+  // Without ground truth the errors are unknown: null, as in every summary.
+  const auto ate = [&](const TrajectoryError SlamErrors::*which) {
+    return errors ? errorJson((*errors).*which) : nlohmann::ordered_json(nullptr);
+  };
+  j["ate_odometry"] = ate(&SlamErrors::odometry);
+  j["ate_slam"] = ate(&SlamErrors::slam);
+  j["ate_odometry_aligned"] = ate(&SlamErrors::odometry_aligned);
+  j["ate_slam_aligned"] = ate(&SlamErrors::slam_aligned);
   j["has_ground_truth"] = errors.has_value();
   j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
   return jsonText(j);

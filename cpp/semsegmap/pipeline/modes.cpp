@@ -290,19 +290,30 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {
   LocalizationSummary s;
   s.localizations = records.size();
-  size_t with_gt = 0;
+  size_t below_1m = 0, below_5m = 0;
+  double translation = 0.0, rotation = 0.0;
   for (const LocalizationRecord& r : records) {
     if (!r.T_world_base) continue;
-    ++with_gt;
-    s.below_1m += r.translation_error_m < 1.0;
-    s.below_5m += r.translation_error_m < 5.0;
-    s.mean_translation_error_m += r.translation_error_m;
-    s.mean_rotation_error_deg += r.rotation_error_deg;
+    ++s.with_ground_truth;
+    below_1m += r.translation_error_m < 1.0;
+    below_5m += r.translation_error_m < 5.0;
+    translation += r.translation_error_m;
+    rotation += r.rotation_error_deg;
   }
-  if (with_gt > 0) {
-    s.mean_translation_error_m /= static_cast<double>(with_gt);
-    s.mean_rotation_error_deg /= static_cast<double>(with_gt);
+  if (s.with_ground_truth == s.localizations) {
+    s.below_1m = below_1m;
+    s.below_5m = below_5m;
   }
+  if (s.with_ground_truth > 0) {
+    s.mean_translation_error_m = translation / static_cast<double>(s.with_ground_truth);
+    s.mean_rotation_error_deg = rotation / static_cast<double>(s.with_ground_truth);
+  }
+  return s;
+}
+
+LocalizationSummary summarize(const LocalizationRun& run) {
+  LocalizationSummary s = summarize(run.localizations);
+  if (run.trajectory_gt.empty()) s.below_1m = s.below_5m = std::nullopt;
   return s;
 }
 

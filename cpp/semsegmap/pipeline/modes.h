@@ -150,9 +150,16 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
                                 MapSettingsCheck settings = MapSettingsCheck::kRefuse);
 
 struct LocalizationSummary {
-  size_t localizations = 0, below_1m = 0, below_5m = 0;
-  double mean_translation_error_m = 0.0, mean_rotation_error_deg = 0.0;
+  size_t localizations = 0;
+  size_t with_ground_truth = 0;  // localizations whose frame had a ground-truth pose
+  // Unknown (empty) rather than zero, which would read as "none within 1 m" or as perfect: the
+  // counts when a localization had no ground truth, the means when none had.
+  std::optional<size_t> below_1m, below_5m;
+  std::optional<double> mean_translation_error_m, mean_rotation_error_deg;
 };
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records);
+// The same, and the counts unknown too when the run had no ground truth at all (no
+// localization then does not mean none was wrong).
+LocalizationSummary summarize(const LocalizationRun& run);
 
 }  // namespace semsegmap
