@@ -93,7 +93,7 @@ TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {
   SummaryContext context;
   context.map_segments = map->size();
   const std::string json = localizationSummaryJson(run, context);
-  for (const char* key : {"n_localizations", "n_with_ground_truth", "n_error_below_1m",
+  for (const char* key : {"schema", "n_localizations", "n_with_ground_truth", "n_error_below_1m",
                           "n_error_below_5m", "mean_translation_error_m", "mean_rotation_error_deg",
                           "fps", "stage_ms", "map_segments", "map_bytes"})
     EXPECT_NE(json.find(std::string("\"") + key + "\""), std::string::npos) << key;
@@ -235,7 +235,7 @@ TEST(Modes, SummaryOfARunWithoutLocalizationsHasNoMeanError) {
 }
 
 // Localizations without ground truth: how many were within 1 m is unknown, null like the mean
-// errors (a 0 read as "none right").
+// errors (a 0 read as "none right"), and the file says its schema.
 TEST(Modes, SummaryWithoutGroundTruthHasNullCountsAndErrors) {
   LocalizationRun run;
   run.stats.frames = 2;
@@ -243,6 +243,7 @@ TEST(Modes, SummaryWithoutGroundTruthHasNullCountsAndErrors) {
   r.inliers = 7;
   run.localizations.assign(2, r);
   const std::string json = localizationSummaryJson(run, SummaryContext{});
+  EXPECT_NE(json.find("\"schema\": \"semsegmap.localization/2\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"n_localizations\": 2"), std::string::npos) << json;
   EXPECT_NE(json.find("\"n_with_ground_truth\": 0"), std::string::npos) << json;
   for (const char* key : {"n_error_below_1m", "n_error_below_5m", "mean_translation_error_m",
@@ -489,6 +490,7 @@ TEST(Modes, SummariesKeepNamesWithQuotesAndBackslashes) {
   // Without ground truth the errors are unknown: null, as in every summary, not left out.
   ASSERT_TRUE(slam.contains("ate_slam"));
   EXPECT_TRUE(slam["ate_slam"].is_null());
+  EXPECT_TRUE(slam["has_frame_times"].get<bool>());
   EXPECT_FALSE(slamErrors(SlamRun{}).has_value());
 
   SummaryContext context;

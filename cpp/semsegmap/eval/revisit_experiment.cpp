@@ -214,6 +214,7 @@ void appendRun(LocalizationRun& all, LocalizationRun run) {
                            run.trajectory_gt.end());
   all.trajectory_odom.insert(all.trajectory_odom.end(), run.trajectory_odom.begin(),
                              run.trajectory_odom.end());
+  all.frames.insert(all.frames.end(), run.frames.begin(), run.frames.end());
   all.distance_m += run.distance_m;
   all.stats.frames += run.stats.frames;
   all.stats.total += run.stats.total;

@@ -282,6 +282,7 @@ Frame FolderReader::frame(size_t index) {
   if (index >= scans_.size()) throwFrameOutOfRange(info_.name, index, scans_.size());
   Frame f;
   f.index = index;
+  f.number = frameNumber(index);
   f.timestamp_s = times_[index];
   DecodedPoints scan = readPointCloudFile(scans_[index]);
   f.points = std::move(scan.points);

@@ -198,6 +198,7 @@ void LocalizationSession::process(const Frame& frame) {
           : (r.T_local_base.translation() - run_.trajectory_odom.back().translation()).norm();
   run_.distance_m += moved;
   run_.trajectory_odom.push_back(r.T_local_base);
+  run_.frames.push_back(stampOf(frame, info_));
   if (frame.T_world_base) run_.trajectory_gt.push_back(*frame.T_world_base);
   const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
   if (frames_++ % every == 0) {
@@ -256,7 +257,9 @@ void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, con
   const Localization& l = *a.found;
   LocalizationRecord rec;
   rec.frame_index = frame.index;
-  rec.timestamp_s = frame.timestamp_s;
+  const FrameStamp stamp = stampOf(frame, info_);
+  rec.frame_number = stamp.number;
+  rec.timestamp_s = stamp.time_s;
   rec.T_map_base = T_map_base;
   rec.inliers = l.inliers;
   rec.candidates = l.candidates;

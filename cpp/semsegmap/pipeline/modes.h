@@ -78,8 +78,9 @@ MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSou
                       std::shared_ptr<Describer> describer, const RunOptions& options = {});
 
 struct LocalizationRecord {
-  size_t frame_index = 0;
-  double timestamp_s = 0.0;
+  size_t frame_index = 0;              // in the run, from 0 (Frame::index)
+  std::optional<size_t> frame_number;  // the dataset's own (Frame::number), when it has one
+  std::optional<double> timestamp_s;   // the data's time; nothing when it has none (FrameStamp)
   Pose T_map_base = Pose::Identity();  // T_map_local * T_local_base
   int inliers = 0;
   size_t candidates = 0;
@@ -100,6 +101,7 @@ struct LocalizationRun {
   std::vector<LocalizationRecord> localizations;
   std::vector<Pose> trajectory_gt;    // empty without ground truth
   std::vector<Pose> trajectory_odom;  // the robot's own estimate, in its odometry frame
+  std::vector<FrameStamp> frames;     // per frame run (as trajectory_odom): the data's names
   double distance_m = 0.0;            // driven, by odometry
   // The odometry was the ground truth itself (DatasetInfo): the errors say how the run does
   // with perfect odometry, and the summaries mark them so.
