@@ -38,8 +38,10 @@ def main():
     run = ssm.run_localization(query, config, built.map, describer, max_frames=args.frames)
     s = run.summary()
     print(f"localized {s.localizations} of {run.stats.frames} frames", end="")
-    if query.info.has_ground_truth_poses:
-        print(f", {s.below_1m} within 1 m, mean error {s.mean_translation_error_m:.2f} m", end="")
+    if s.below_1m is not None:  # None: no ground truth measured it
+        print(f", {s.below_1m} within 1 m", end="")
+    if s.mean_translation_error_m is not None:
+        print(f", mean error {s.mean_translation_error_m:.2f} m", end="")
     print()
     if run.localizations:
         last = run.localizations[-1]

@@ -19,6 +19,11 @@ HEADER = ("| rig | run | config | localizations | < 1 m | wrong (> 5 m) | mean e
           "| recall (20 m) |\n| --- | --- | --- | ---: | ---: | ---: | --- | ---: |\n")
 
 
+def shown(value):
+    """A count as the table shows it: "-" for one the run did not know (null)."""
+    return "-" if value is None else value
+
+
 def rows(label, path):
     try:
         with open(path, encoding="utf-8") as f:
@@ -29,10 +34,14 @@ def rows(label, path):
         sys.exit(f"{path}: not a localization.json of semsegmap eval localization (no results)")
     out = []
     for r in experiment["results"]:
-        error = (f"{r['mean_translation_error_m']:.2f} m / {r['mean_rotation_error_deg']:.2f} deg"
-                 if r["n_localizations"] else "-")
+        # Unknown values (no localization, no ground truth) are null: shown as "-", never 0.
+        translation, rotation = r.get("mean_translation_error_m"), r.get("mean_rotation_error_deg")
+        error = (f"{translation:.2f} m / {rotation:.2f} deg"
+                 if r["n_localizations"] and translation is not None and rotation is not None
+                 else "-")
+        below_1m = shown(r.get("n_error_below_1m"))
         out.append(f"| {label} | {r['run']} | {r['config']} | {r['n_localizations']} "
-                   f"| {r['n_error_below_1m']} | {r['n_wrong']} | {error} "
+                   f"| {below_1m} | {r['n_wrong']} | {error} "
                    f"| {r['recall_along_trajectory']:.2f} |\n")
     return out
 

@@ -902,6 +902,52 @@ TEST(CliPoseFiles, GroundTruthAsOdometryIsSaidAndMarked) {
   }
 }
 
+// The n-th line of a CSV file as its fields (line 0: the header).
+std::vector<std::string> csvLine(const std::filesystem::path& file, size_t n) {
+  std::istringstream in(readFile(file));
+  std::string line;
+  for (size_t i = 0; i <= n; ++i) std::getline(in, line);
+  std::vector<std::string> fields;
+  std::istringstream cells(line + ",");  // a last empty field is a field too
+  for (std::string cell; std::getline(cells, cell, ',');) fields.push_back(cell);
+  return fields;
+}
+
+// Scans named by frame number (000001.bin left out), odometry from a KITTI file, no ground truth
+// and no times: what is unknown is null or empty, never 0 or made up, frames are named as the
+// dataset names them, and the summary line says no "<1 m".
+TEST(CliPoseFiles, WithoutGroundTruthOrTimesNothingIsMadeUp) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path data = copyOfDataset(tmp.path() / "data"), dir = tmp.path();
+  std::filesystem::remove(data / "lidar" / "000001.bin");
+  std::ofstream(dir / "odom.txt") << poseFilesOf(data, "odom_").kitti;
+  const std::string config = " --config " + eigenConfig(dir, "eigen.yaml");
+  const std::string scans = " --dataset folder:" + (data / "lidar").string() + " --odometry " +
+                            (dir / "odom.txt").string();
+  const std::string map = (dir / "m.map").string();
+  ASSERT_EQ(run("map" + scans + config + " --out " + map).code, 0);
+  const Result l =
+      run("localize" + scans + config + " --map " + map + " --out " + (dir / "loc").string());
+  ASSERT_EQ(l.code, 0) << l.err;
+  EXPECT_NE(l.out.find("(no ground truth: errors unknown)"), std::string::npos) << l.out;
+  EXPECT_EQ(l.out.find("<1 m"), std::string::npos) << l.out;
+  const std::string summary = readFile(dir / "loc" / "summary.json");
+  EXPECT_NE(summary.find("\"schema\": \"semsegmap.localization/2\""), std::string::npos);
+  EXPECT_NE(summary.find("\"n_error_below_1m\": null"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"n_error_below_5m\": null"), std::string::npos) << summary;
+  const std::vector<std::string> header = csvLine(dir / "loc" / "localizations.csv", 0);
+  ASSERT_GE(header.size(), 3u);
+  EXPECT_EQ(header[1], "dataset_frame");
+  EXPECT_EQ(header[2], "timestamp");
+  // Run frame 1 is the scan named 000002: its number, and no time (the data has none).
+  const std::vector<std::string> second = csvLine(dir / "loc" / "trajectory.csv", 2);
+  ASSERT_GE(second.size(), 3u);
+  EXPECT_EQ(second[0], "1");
+  EXPECT_EQ(second[1], "2");
+  EXPECT_EQ(second[2], "");
+}
+
 // map --out naming a directory or an unwritable place used to fail after every frame.
 TEST(CliUpFront, OutputsOfTheWrongKindOrUnwritableFailBeforeFrame0) {
   if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";

@@ -644,6 +644,8 @@ TEST(PoseFiles, KittiLineNBelongsToTheScanNamedN) {
     for (size_t i = 0; i < 4; ++i) {
       const Frame f = source->frame(i);
       EXPECT_EQ(source->frameNumber(i), static_cast<size_t>(expected[i]));
+      // The frame carries its name through the pose files' wrapper: outputs name it so.
+      EXPECT_EQ(f.number, source->frameNumber(i));
       EXPECT_FLOAT_EQ(f.points.at(0).x, static_cast<float>(expected[i])) << "scan order";
       EXPECT_NEAR(f.T_world_base->translation().x(), expected[i], 1e-12) << "digits " << digits;
       EXPECT_NEAR(f.T_odom_base.translation().x(), expected[i], 1e-12);

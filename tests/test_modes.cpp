@@ -78,8 +78,9 @@ TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {
   const LocalizationRun run = runLocalization(*query, config, map, oracle);
   const LocalizationSummary s = summarize(run.localizations);
   EXPECT_GT(s.localizations, 20u);
-  EXPECT_EQ(s.below_1m, s.localizations);  // true matches only: every pose is right
-  EXPECT_LT(s.mean_rotation_error_deg, 2.0);
+  EXPECT_EQ(s.with_ground_truth, s.localizations);
+  EXPECT_EQ(s.below_1m.value(), s.localizations);  // true matches only: every pose is right
+  EXPECT_LT(s.mean_rotation_error_deg.value(), 2.0);
   for (const LocalizationRecord& r : run.localizations) {
     EXPECT_GE(r.inliers, config.localization.localizer.verification.min_inliers);
     ASSERT_EQ(r.matches.size(), static_cast<size_t>(r.inliers));
@@ -92,9 +93,9 @@ TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {
   SummaryContext context;
   context.map_segments = map->size();
   const std::string json = localizationSummaryJson(run, context);
-  for (const char* key :
-       {"n_localizations", "n_error_below_1m", "n_error_below_5m", "mean_translation_error_m",
-        "mean_rotation_error_deg", "fps", "stage_ms", "map_segments", "map_bytes"})
+  for (const char* key : {"schema", "n_localizations", "n_with_ground_truth", "n_error_below_1m",
+                          "n_error_below_5m", "mean_translation_error_m", "mean_rotation_error_deg",
+                          "fps", "stage_ms", "map_segments", "map_bytes"})
     EXPECT_NE(json.find(std::string("\"") + key + "\""), std::string::npos) << key;
 }
 
@@ -229,6 +230,50 @@ TEST(Modes, SummaryOfARunWithoutLocalizationsHasNoMeanError) {
   const std::string json = localizationSummaryJson(run, SummaryContext{});
   EXPECT_NE(json.find("\"mean_translation_error_m\": null"), std::string::npos) << json;
   EXPECT_NE(json.find("\"mean_rotation_error_deg\": null"), std::string::npos) << json;
+  // With ground truth, none of no localization is within 1 m: a count, known.
+  EXPECT_NE(json.find("\"n_error_below_1m\": 0"), std::string::npos) << json;
+}
+
+// Localizations without ground truth: how many were within 1 m is unknown, null like the mean
+// errors (a 0 read as "none right"), and the file says its schema.
+TEST(Modes, SummaryWithoutGroundTruthHasNullCountsAndErrors) {
+  LocalizationRun run;
+  run.stats.frames = 2;
+  LocalizationRecord r;
+  r.inliers = 7;
+  run.localizations.assign(2, r);
+  const std::string json = localizationSummaryJson(run, SummaryContext{});
+  EXPECT_NE(json.find("\"schema\": \"semsegmap.localization/2\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"n_localizations\": 2"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"n_with_ground_truth\": 0"), std::string::npos) << json;
+  for (const char* key : {"n_error_below_1m", "n_error_below_5m", "mean_translation_error_m",
+                          "mean_rotation_error_deg"})
+    EXPECT_NE(json.find("\"" + std::string(key) + "\": null"), std::string::npos) << key << json;
+  const LocalizationSummary s = summarize(run);
+  EXPECT_FALSE(s.below_1m.has_value());
+  EXPECT_FALSE(s.mean_translation_error_m.has_value());
+}
+
+// Some localizations with ground truth, some without: the means are over those measured, the
+// counts unknown (how many of the others were within 1 m is not known).
+TEST(Modes, SummaryOfPartlyMeasuredLocalizations) {
+  std::vector<LocalizationRecord> records(3);
+  records[0].T_world_base = Pose::Identity();
+  records[0].translation_error_m = 0.5;
+  records[0].rotation_error_deg = 1.0;
+  records[1].T_world_base = Pose::Identity();
+  records[1].translation_error_m = 3.5;
+  records[1].rotation_error_deg = 3.0;
+  const LocalizationSummary partly = summarize(records);
+  EXPECT_EQ(partly.localizations, 3u);
+  EXPECT_EQ(partly.with_ground_truth, 2u);
+  EXPECT_FALSE(partly.below_1m.has_value());
+  EXPECT_DOUBLE_EQ(partly.mean_translation_error_m.value(), 2.0);
+  records.pop_back();
+  const LocalizationSummary all = summarize(records);
+  EXPECT_EQ(all.below_1m, std::optional<size_t>(1));
+  EXPECT_EQ(all.below_5m, std::optional<size_t>(2));
+  EXPECT_DOUBLE_EQ(all.mean_rotation_error_deg.value(), 2.0);
 }
 
 // The session itself (not only the CLI) compares the map's recorded settings with its own: a
@@ -345,9 +390,10 @@ TEST(Modes, PoseRefinementOnLidarOdometryBringsLocalizationsCloserThanCentroidsA
   size_t applied = 0;
   for (const LocalizationRecord& r : refined_run.localizations) applied += r.refined;
   EXPECT_GT(applied, refined.localizations / 2);
-  EXPECT_LT(refined.mean_translation_error_m, 0.5 * centroids.mean_translation_error_m);
-  EXPECT_LT(refined.mean_translation_error_m, 0.06);
-  EXPECT_LT(refined.mean_rotation_error_deg, centroids.mean_rotation_error_deg);
+  EXPECT_LT(refined.mean_translation_error_m.value(),
+            0.5 * centroids.mean_translation_error_m.value());
+  EXPECT_LT(refined.mean_translation_error_m.value(), 0.06);
+  EXPECT_LT(refined.mean_rotation_error_deg.value(), centroids.mean_rotation_error_deg.value());
 }
 
 TEST(Modes, RefinementRefusesAMapWithoutPoints) {
@@ -441,7 +487,10 @@ TEST(Modes, SummariesKeepNamesWithQuotesAndBackslashes) {
   const nlohmann::json slam = nlohmann::json::parse(slamSummaryJson(SlamRun{}, name));
   EXPECT_EQ(slam["dataset"], name);
   EXPECT_FALSE(slam["has_ground_truth"].get<bool>());
-  EXPECT_FALSE(slam.contains("ate_slam"));
+  // Without ground truth the errors are unknown: null, as in every summary, not left out.
+  ASSERT_TRUE(slam.contains("ate_slam"));
+  EXPECT_TRUE(slam["ate_slam"].is_null());
+  EXPECT_TRUE(slam["has_frame_times"].get<bool>());
   EXPECT_FALSE(slamErrors(SlamRun{}).has_value());
 
   SummaryContext context;

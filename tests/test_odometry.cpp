@@ -80,6 +80,30 @@ Pose motion(double dx, double dy, double yaw_deg) {
 
 // ---- registration ----
 
+// Without ground truth the summary's errors are null (as every summary's), and a trajectory
+// with no 100 m stretch has no KITTI relative error: null, not 0 %.
+TEST(OdometrySummary, UnknownErrorsAreNull) {
+  OdometryRun run;
+  run.dataset = "scans";
+  for (int i = 0; i < 3; ++i) run.trajectory.push_back({0.1 * i, planarPose(i, 0, 0, 0)});
+  run.frames.resize(3);
+  EXPECT_FALSE(odometryErrors(run).has_value());
+  const nlohmann::ordered_json j = toJson(run, odometryErrors(run));
+  EXPECT_FALSE(j["has_ground_truth"].get<bool>());
+  for (const char* key : {"kitti_relative_error", "ate", "ate_aligned"}) {
+    ASSERT_TRUE(j.contains(key)) << key;  // written as null, not left out
+    EXPECT_TRUE(j.at(key).is_null()) << key << ": " << j.at(key);
+  }
+  for (const Pose& T : posesOf(run.trajectory)) run.ground_truth.push_back(T);
+  const std::optional<OdometryErrors> errors = odometryErrors(run);
+  ASSERT_TRUE(errors.has_value());
+  ASSERT_TRUE(errors->kitti.segments.empty());  // 2 m driven
+  const nlohmann::ordered_json measured = toJson(run, errors);
+  EXPECT_TRUE(measured["kitti_relative_error"]["translation_percent"].is_null());
+  EXPECT_EQ(measured["kitti_relative_error"]["segments"], 0);
+  EXPECT_NEAR(measured["ate"]["rmse_m"].get<double>(), 0.0, 1e-9);
+}
+
 TEST(Odometry, RegistrationRecoversAKnownRigidMotion) {
   const auto world = streetWorld();
   const Pose start = planarPose(0, 0, 1.8, 0);

@@ -1,10 +1,13 @@
 // The gnuplot wrapper: a PNG with the data beside it, and clear errors.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/io/image_io.h"
+#include "semsegmap/viz/localization_png.h"
 #include "semsegmap/viz/plot.h"
 #include "temp_dir.h"
 
@@ -90,6 +93,44 @@ TEST(Plot, BarsWithLabelsAndStepsAreDrawn) {
   viz::Panel bad = bars;
   bad.series[0].labels.pop_back();
   EXPECT_THROW(viz::plotPanels(tmp.path() / "bad.png", "bad", {bad}), std::invalid_argument);
+}
+
+// The bird's-eye picture of a run along x with three localizations, and its legend's dots at
+// the bottom left, top to bottom (rows - 70, rows - 50, rows - 30 px): their colours, RGB.
+std::vector<std::array<uint8_t, 3>> legendDots(const std::filesystem::path& png,
+                                               bool has_ground_truth) {
+  viz::LocalizationPicture pic;
+  pic.title = "legend";
+  pic.has_ground_truth = has_ground_truth;
+  for (int i = 0; i < 10; ++i) pic.trajectory.push_back(planarPose(10.0 * i, 0, 0, 0));
+  const double unknown = -1.0;
+  for (int i = 1; i < 4; ++i)
+    pic.localizations.emplace_back(Eigen::Vector3d(20.0 * i, 0, 0),
+                                   has_ground_truth ? 0.3 * i : unknown);
+  viz::writeLocalizationPng(png, pic);
+  const Image image = readPng(png);
+  std::vector<std::array<uint8_t, 3>> dots;
+  for (const int up : {70, 50, 30}) {
+    const uint8_t* p = image.at(20, image.height - up);
+    dots.push_back({p[0], p[1], p[2]});
+  }
+  return dots;
+}
+
+// Without ground truth every dot has the unknown-error colour: the legend shows that colour
+// alone, named so, and no error scale whose green no dot could have.
+TEST(LocalizationPng, TheLegendWithoutGroundTruthShowsNoErrorColours) {
+  TempDir tmp;
+  using Rgb = std::array<uint8_t, 3>;
+  const Rgb unknown{80, 200, 255}, green{60, 220, 80}, red{230, 40, 40};
+  const auto with = legendDots(tmp.path() / "with.png", true);
+  EXPECT_EQ(with[0], green);
+  EXPECT_EQ(with[2], red);
+  const auto without = legendDots(tmp.path() / "without.png", false);
+  EXPECT_EQ(without[2], unknown);
+  EXPECT_NE(without[0], green);
+  EXPECT_NE(without[1], green);
+  EXPECT_NE(without[0], unknown);  // one entry only
 }
 
 }  // namespace

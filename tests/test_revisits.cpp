@@ -21,6 +21,25 @@ using test_support::TempDir;
 
 const std::string kSource = SEMSEGMAP_SOURCE_DIR;
 
+// What revisits.json does not know is null: no scan registered (no correction measured), a
+// localization whose scan did not register, a wake-up that never localized, a mean of nothing.
+TEST(RevisitResults, UnknownValuesAreNullInTheJson) {
+  RevisitExperiment e;
+  RevisitResult& r = e.results.emplace_back();
+  r.localizations.push_back({12, 7, 0.4, 1.0});  // registered errors -1: none
+  r.wake_ups.push_back({{10, 14}, true, 0, false});
+  const nlohmann::ordered_json j = toJson(e);
+  EXPECT_TRUE(j["mean_ground_truth_correction_m"].is_null());
+  EXPECT_TRUE(j["max_ground_truth_correction_m"].is_null());
+  const nlohmann::ordered_json& result = j["results"][0];
+  EXPECT_TRUE(result["mean_translation_error_m"].is_null());
+  EXPECT_TRUE(result["mean_registered_error_m"].is_null());
+  EXPECT_TRUE(result["localizations"][0]["registered_error_m"].is_null());
+  EXPECT_DOUBLE_EQ(result["localizations"][0]["translation_error_m"].get<double>(), 0.4);
+  EXPECT_TRUE(result["wake_ups"][0]["localized_at_frame"].is_null());
+  EXPECT_NE(revisitTable(e).find("| - |"), std::string::npos) << revisitTable(e);
+}
+
 TEST(RevisitRanges, ParseListsAndSingleFrames) {
   const std::vector<FrameRange> r = parseFrameRanges("0:5,9,12:20", "--map-frames");
   ASSERT_EQ(r.size(), 3u);

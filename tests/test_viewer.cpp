@@ -117,6 +117,60 @@ TEST(LocalizationDetails, WithoutGroundTruthTheGroundTruthColumnsStayEmpty) {
   EXPECT_FALSE(f.trajectory[0].T_world_base.has_value());
 }
 
+// A frame is named as the dataset names it beside the run's index (scan 001576.bin is frame 27
+// of the run), and a time the data does not have is left empty, never made up.
+TEST(LocalizationDetails, FramesKeepTheDatasetsNumberAndOnlyTheDatasTime) {
+  TempDir tmp;
+  LocalizationRun run = smallRun();
+  for (size_t i = 0; i < run.trajectory_odom.size(); ++i)
+    run.frames.push_back({1574 + i, std::nullopt});  // named by number, no times in the data
+  run.localizations[0].frame_number = 1576;
+  run.localizations[0].timestamp_s.reset();
+  writeRun(tmp.path(), run);
+  const CsvTable csv = CsvTable::read(tmp.path() / "localizations.csv");
+  EXPECT_EQ(csv.text(0, csv.column("frame")), "2");
+  EXPECT_EQ(csv.text(0, csv.column("dataset_frame")), "1576");
+  EXPECT_EQ(csv.text(0, csv.column("timestamp")), "");
+  const LocalizationFolder f = readLocalizationFolder(tmp.path());
+  EXPECT_EQ(f.localizations[0].frame, 2u);
+  EXPECT_EQ(f.localizations[0].dataset_frame, std::optional<size_t>(1576));
+  EXPECT_FALSE(f.localizations[0].timestamp_s.has_value());
+  ASSERT_EQ(f.trajectory.size(), 5u);
+  EXPECT_EQ(f.trajectory[3].dataset_frame, std::optional<size_t>(1577));
+  EXPECT_FALSE(f.trajectory[3].timestamp_s.has_value());
+  // The page is given both, the time as null.
+  const TargetMap map = smallMap();
+  viz::SceneInputs in;
+  in.map = &map;
+  in.localization = &f;
+  const nlohmann::ordered_json record = viz::sceneJson(in)["localization"]["records"][0];
+  EXPECT_EQ(record["frame"], 2);
+  EXPECT_EQ(record["dataset_frame"], 1576);
+  EXPECT_TRUE(record["time"].is_null()) << record["time"];
+  // A time the data has is written as it is.
+  run.localizations[0].timestamp_s = 1317384506.25;
+  writeRun(tmp.path(), run);
+  EXPECT_NEAR(readLocalizationFolder(tmp.path()).localizations[0].timestamp_s.value(),
+              1317384506.25, 1e-6);
+}
+
+// Folders written before the schema had a version (no dataset_frame, a timestamp always, no
+// "schema" in summary.json) are still read.
+TEST(LocalizationDetails, Version1FilesAreStillRead) {
+  TempDir tmp;
+  std::ofstream(tmp.path() / "localizations.csv")
+      << "frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,rotation_error_deg\n"
+         "4,0.400000,1.0,2.0,0.0,0,0,0,1,7,,\n";
+  std::ofstream(tmp.path() / "summary.json") << "{\"dataset\": \"old\"}\n";
+  const LocalizationFolder f = readLocalizationFolder(tmp.path());
+  ASSERT_EQ(f.localizations.size(), 1u);
+  EXPECT_EQ(f.localizations[0].frame, 4u);
+  EXPECT_FALSE(f.localizations[0].dataset_frame.has_value());
+  EXPECT_NEAR(f.localizations[0].timestamp_s.value(), 0.4, 1e-9);
+  EXPECT_EQ(f.schema, "semsegmap.localization/1");
+  EXPECT_EQ(f.dataset, "old");
+}
+
 TEST(LocalizationDetails, BadFoldersAndFilesAreOneLineNamingThem) {
   TempDir tmp;
   std::string e = errorOf([&] { readLocalizationFolder(tmp.path() / "missing"); });
@@ -228,9 +282,18 @@ std::vector<Segment> twoSegments() {
 
 TEST(RunFolders, SegmentsReadBackAndGroupedBySegment) {
   TempDir tmp;
-  const std::vector<Segment> segments = twoSegments();
-  writeSegmentsCsv(tmp.path() / "segments.csv", segments, ClassTable::Default(), false);
+  std::vector<Segment> segments = twoSegments();
+  segments[0].first_frame = 1;
+  segments[0].last_frame = 5;
+  // Frames 0 and 1 of the run are the dataset's scans 40 and 42; frame 5 has no number.
+  writeSegmentsCsv(tmp.path() / "segments.csv", segments, ClassTable::Default(), false, {40, 42});
   writeSegmentPointsPly(tmp.path() / "segments.ply", segments);
+  const CsvTable csv = CsvTable::read(tmp.path() / "segments.csv");
+  EXPECT_EQ(csv.text(0, csv.column("first_frame")), "1");
+  EXPECT_EQ(csv.text(0, csv.column("first_dataset_frame")), "42");
+  EXPECT_EQ(csv.text(0, csv.column("last_frame")), "5");
+  EXPECT_EQ(csv.text(0, csv.column("last_dataset_frame")), "");
+  EXPECT_EQ(csv.text(0, csv.column("gt_purity")), "");  // no ground truth: unknown, not 0
   const SegmentFolder f = readSegmentFolder(tmp.path());
   ASSERT_EQ(f.segments.size(), 2u);
   EXPECT_EQ(f.segments[1].id, 8);

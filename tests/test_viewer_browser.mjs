@@ -68,6 +68,7 @@ async function run() {
     const stats = document.getElementById('stats');
     if (v.error) return { error: v.error };
     return { error: v.error, stats: v.stats, loadMs: v.loadMs, buildMs: v.buildMs, layers: v.layers(),
+             unknownColour: v.classColour(0),
              dom: { segments: Number(stats.dataset.segments), localizations: Number(stats.dataset.localizations),
                     listed: document.querySelectorAll('#localizations li[data-index]').length,
                     legend: document.querySelectorAll('#legend li').length } };

@@ -211,6 +211,13 @@ void expectCountsOf(const nlohmann::json& page, const std::filesystem::path& dir
   EXPECT_EQ(stats["segmentRunSegments"], csvRows(dir / "seg" / "segments.csv"));
   EXPECT_EQ(stats["loops"], csvRows(dir / "slam" / "loops.csv"));
   EXPECT_GT(page["dom"]["legend"].get<int>(), 2);
+  // Class unknown (a LiDAR-only map is all of it) in a light neutral grey, not the class table's
+  // black, which vanishes on the page's near-black background.
+  const nlohmann::json& unknown = page["unknownColour"];
+  ASSERT_EQ(unknown.size(), 3u) << unknown;
+  EXPECT_GE(unknown[0].get<int>(), 150) << unknown;
+  EXPECT_EQ(unknown[0], unknown[1]) << unknown;
+  EXPECT_EQ(unknown[1], unknown[2]) << unknown;
 }
 
 void expectInteraction(const nlohmann::json& page) {

@@ -20,6 +20,26 @@ namespace semsegmap::app {
 
 namespace {
 
+// One line: counts, errors (only what ground truth measured: no "0 within 1 m" without it) and
+// speed.
+void printLocalizationSummary(const LocalizationRun& run) {
+  const LocalizationSummary s = summarize(run);
+  std::printf("frames %zu  localizations %zu", run.stats.frames, s.localizations);
+  if (s.below_1m && s.below_5m)
+    std::printf("  <1 m %zu  <5 m %zu", *s.below_1m, *s.below_5m);
+  else if (s.localizations > 0 && s.with_ground_truth > 0)
+    std::printf("  (%zu with ground truth)", s.with_ground_truth);
+  if (s.mean_translation_error_m && s.mean_rotation_error_deg)
+    std::printf("  mean error %.2f m %.2f deg", *s.mean_translation_error_m,
+                *s.mean_rotation_error_deg);
+  if (run.trajectory_gt.empty()) std::printf("  (no ground truth: errors unknown)");
+  std::printf("  %.1f Hz", run.stats.fps());
+  // Errors against the poses the local map was built on say little: marked.
+  if (run.odometry_is_ground_truth && s.mean_translation_error_m)
+    std::printf("  [errors against the ground truth used as odometry]");
+  std::printf("\n");
+}
+
 int runLocalize(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
   const std::filesystem::path map_path = a.get("map");
@@ -65,19 +85,7 @@ int runLocalize(const CliArgs& a) {
   // Last: a summary says the run completed.
   writeBytesAtomically(out / "summary.json", localizationSummaryJson(run, context));
 
-  const LocalizationSummary s = summarize(run.localizations);
-  if (run.trajectory_gt.empty())  // errors need ground truth; zeros would read as perfect
-    std::printf("frames %zu  localizations %zu  (no ground truth: errors unknown)  %.1f Hz\n",
-                run.stats.frames, s.localizations, run.stats.fps());
-  else if (s.localizations == 0)  // no mean of nothing: "0.00 m" would read as perfect
-    std::printf("frames %zu  localizations 0  %.1f Hz\n", run.stats.frames, run.stats.fps());
-  else  // errors against the poses the local map was built on say little: marked
-    std::printf(
-        "frames %zu  localizations %zu  <1 m %zu  <5 m %zu  mean error %.2f m %.2f deg  "
-        "%.1f Hz%s\n",
-        run.stats.frames, s.localizations, s.below_1m, s.below_5m, s.mean_translation_error_m,
-        s.mean_rotation_error_deg, run.stats.fps(),
-        run.odometry_is_ground_truth ? "  [errors against the ground truth used as odometry]" : "");
+  printLocalizationSummary(run);
   std::cout << "wrote " << (out / "localizations.csv").string()
             << ", matches.csv, trajectory.csv, summary.json, localization.png\n";
   return 0;

@@ -30,12 +30,17 @@ int runOdometryCommand(const CliArgs& a) {
   for (const OdometryResult& r : run.frames) predicted += r.usedPrediction();
   std::printf("frames %zu  %.1f ms/frame  prediction used %zu\n", run.frames.size(),
               run.frames.empty() ? 0.0 : 1e3 * run.seconds / run.frames.size(), predicted);
-  if (errors)
+  if (errors && errors->kitti.segments.empty())  // shorter than KITTI's shortest length
+    std::printf("KITTI relative error unknown (no 100 m stretch)  ATE %.2f m (aligned %.2f m)\n",
+                errors->ate.rmse_m, errors->ate_aligned.rmse_m);
+  else if (errors)
     std::printf(
         "KITTI relative error %.2f %%  %.3f deg/100 m (%zu segments)  ATE %.2f m "
         "(aligned %.2f m)\n",
         errors->kitti.translation_percent, errors->kitti.rotation_deg_per_100m,
         errors->kitti.segments.size(), errors->ate.rmse_m, errors->ate_aligned.rmse_m);
+  else
+    std::printf("no ground truth: errors unknown\n");
   std::cout << "wrote " << (out / "trajectory_tum.txt").string()
             << ", trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << "\n";
   return 0;

@@ -52,8 +52,12 @@ int runSegment(const CliArgs& a) {
   StageTimes total;
   size_t merges = 0;
   Progress progress("segment", n);
+  std::vector<std::optional<size_t>> numbers;  // the dataset's own, by frame index
   for (size_t i = 0; i < n; ++i) {
-    FrameResult r = pipeline.process(source->frame(i));
+    const Frame frame = source->frame(i);
+    if (numbers.size() <= frame.index) numbers.resize(frame.index + 1);
+    numbers[frame.index] = frame.number;
+    FrameResult r = pipeline.process(frame);
     trajectory.push_back(r.T_local_base);
     merges += r.segmentation.merges.size();
     for (auto& s : r.segmentation.finished) segments.push_back(std::move(s));
@@ -67,7 +71,7 @@ int runSegment(const CliArgs& a) {
             [](const Segment& x, const Segment& y) { return x.id < y.id; });
 
   const bool has_gt = source->info().has_point_labels;
-  writeSegmentsCsv(out / "segments.csv", segments, source->info().classes, has_gt);
+  writeSegmentsCsv(out / "segments.csv", segments, source->info().classes, has_gt, numbers);
   writeSegmentPointsPly(out / "segments.ply", segments);
   viz::writeSegmentsPng(
       out / "segments.png", segments, trajectory,

@@ -133,6 +133,8 @@ void bindFrame(py::module_& m) {
            "seconds after timestamp_s; images and label_images one per rig camera, (H, W, 3) RGB "
            "and (H, W) class ids (None for a camera without); poses 4x4.")
       .def_readwrite("index", &Frame::index)
+      .def_readwrite("number", &Frame::number,
+                     "the dataset's own number of the frame (its scan's name), or None")
       .def_readwrite("timestamp_s", &Frame::timestamp_s)
       .def_property_readonly(
           "points",

@@ -59,6 +59,14 @@ void bindTargetMap(py::module_& m) {
           "parameters", [](const TargetMap& map) { return parametersDict(map.parameters); },
           "dict of the settings the map was built with (pipeline/map_parameters.h), a copy")
       .def("__len__", &TargetMap::size)
+      .def(
+          "__repr__",
+          [](const TargetMap& map) {
+            return "TargetMap(descriptor=" + py::repr(py::str(map.descriptor)).cast<std::string>() +
+                   ", segments=" + std::to_string(map.size()) +
+                   ", dimension=" + std::to_string(map.dimension()) +
+                   ", source=" + py::repr(py::str(map.source)).cast<std::string>() + ")";
+          })
       .def_property_readonly("dimension", &TargetMap::dimension)
       .def_property_readonly(
           "descriptors",
@@ -115,7 +123,10 @@ void bindBuilder(py::module_& m) {
 }
 
 void bindLocalizer(py::module_& m) {
-  py::class_<Localization>(m, "Localization", "A match of the local segments against the map")
+  py::class_<Localization> localization(m, "Localization",
+                                        "A match of the local segments against the map");
+  defRepr(localization, "Localization", {"inliers", "candidates"});
+  localization
       .def_property_readonly("T_map_local",
                              [](const Localization& l) { return poseArray(l.T_map_local); })
       .def_readonly("inliers", &Localization::inliers)

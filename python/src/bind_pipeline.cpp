@@ -1,6 +1,7 @@
 // pipeline/: the front end frame by frame (Pipeline), its results and local segments, and the
 // mapping and localization modes (pipeline/modes.h) by frame or over a whole dataset. Every call
 // that processes frames releases the GIL.
+#include <cstdio>
 #include <stdexcept>
 
 #include "bindings.h"
@@ -84,17 +85,20 @@ py::array_t<EnrichedPoint> segmentPoints(const Pipeline& p, SegmentId id) {
 }
 
 void bindResults(py::module_& m) {
-  py::class_<StageTimes>(m, "StageTimes", "Milliseconds per stage")
-      .def_readonly("enrich_ms", &StageTimes::enrich_ms)
+  py::class_<StageTimes> times(m, "StageTimes", "Milliseconds per stage");
+  times.def_readonly("enrich_ms", &StageTimes::enrich_ms)
       .def_readonly("local_map_ms", &StageTimes::local_map_ms)
       .def_readonly("segment_ms", &StageTimes::segment_ms)
       .def_readonly("describe_ms", &StageTimes::describe_ms)
       .def_readonly("localize_ms", &StageTimes::localize_ms)
       .def_property_readonly("total_ms", &StageTimes::total);
-  py::class_<RunStats>(m, "RunStats", "Frames processed and the pipeline's time over them")
-      .def_readonly("frames", &RunStats::frames)
+  defRepr(times, "StageTimes",
+          {"enrich_ms", "local_map_ms", "segment_ms", "describe_ms", "localize_ms", "total_ms"});
+  py::class_<RunStats> stats(m, "RunStats", "Frames processed and the pipeline's time over them");
+  stats.def_readonly("frames", &RunStats::frames)
       .def_readonly("total", &RunStats::total)
       .def_property_readonly("fps", &RunStats::fps);
+  defRepr(stats, "RunStats", {"frames", "fps"});
 
   py::class_<SegmentObservation>(m, "SegmentObservation", "One observation of a segment")
       .def_readonly("frame_index", &SegmentObservation::frame_index)
@@ -111,8 +115,9 @@ void bindResults(py::module_& m) {
             return py::array_t<EnrichedPoint>({c.size()}, {sizeof(EnrichedPoint)}, c.data(), self);
           },
           "ENRICHED_POINT_DTYPE view, map frame; empty for older observations unless kept");
-  py::class_<Segment>(m, "Segment", "A segment and its observations (segment/segment.h)")
-      .def_readonly("id", &Segment::id)
+  py::class_<Segment> segment(m, "Segment", "A segment and its observations (segment/segment.h)");
+  defRepr(segment, "Segment", {"id", "first_frame", "last_frame"});
+  segment.def_readonly("id", &Segment::id)
       .def_readonly("first_frame", &Segment::first_frame)
       .def_readonly("last_frame", &Segment::last_frame)
       .def_readonly("observations", &Segment::observations)
@@ -120,8 +125,9 @@ void bindResults(py::module_& m) {
           "last", [](const Segment& s) -> const SegmentObservation& { return s.last(); },
           py::return_value_policy::reference_internal, "the latest, most complete observation");
 
-  py::class_<FrameResult>(m, "FrameResult", "What the front end did with one frame")
-      .def_readonly("frame_index", &FrameResult::frame_index)
+  py::class_<FrameResult> frame(m, "FrameResult", "What the front end did with one frame");
+  defRepr(frame, "FrameResult", {"frame_index", "points", "described", "times"});
+  frame.def_readonly("frame_index", &FrameResult::frame_index)
       .def_property_readonly("T_local_base",
                              [](const FrameResult& r) { return poseArray(r.T_local_base); })
       .def_readonly("points", &FrameResult::points)
@@ -217,8 +223,9 @@ void bindPipelineClass(py::module_& m) {
 }
 
 void bindMapping(py::module_& m) {
-  py::class_<MappingResult>(m, "MappingRun", "A target map built from a run")
-      .def_readonly("map", &MappingResult::map)
+  py::class_<MappingResult> mapping(m, "MappingRun", "A target map built from a run");
+  defRepr(mapping, "MappingRun", {"segments", "duplicates_removed", "map", "stats"});
+  mapping.def_readonly("map", &MappingResult::map)
       .def_property_readonly(
           "trajectory", [](const MappingResult& r) { return posesArray(r.trajectory); },
           "(N, 4, 4): the poses the map was built with")
@@ -262,10 +269,21 @@ void bindMapping(py::module_& m) {
       "Maps the first max_frames frames (0: all), as `semsegmap map` does");
 }
 
-void bindLocalizationResults(py::module_& m) {
-  py::class_<LocalizationRecord>(m, "LocalizationRecord", "One localization of a run")
-      .def_readonly("frame_index", &LocalizationRecord::frame_index)
-      .def_readonly("timestamp_s", &LocalizationRecord::timestamp_s)
+// A record's error against ground truth; None without it (a 0.0 would read as perfect).
+py::object errorOf(const LocalizationRecord& l, double LocalizationRecord::*error) {
+  return l.T_world_base ? py::cast(l.*error) : py::none();
+}
+
+void bindLocalizationRecord(py::module_& m) {
+  py::class_<LocalizationRecord> record(m, "LocalizationRecord", "One localization of a run");
+  defRepr(record, "LocalizationRecord",
+          {"frame_index", "frame_number", "timestamp_s", "inliers", "translation_error_m",
+           "rotation_error_deg"});
+  record.def_readonly("frame_index", &LocalizationRecord::frame_index, "in the run, from 0")
+      .def_readonly("frame_number", &LocalizationRecord::frame_number,
+                    "the dataset's own number of the frame (its scan's name), or None")
+      .def_readonly("timestamp_s", &LocalizationRecord::timestamp_s,
+                    "the data's time of the frame, or None when the data has none")
       .def_property_readonly("T_map_base",
                              [](const LocalizationRecord& l) { return poseArray(l.T_map_base); })
       .def_readonly("inliers", &LocalizationRecord::inliers)
@@ -275,8 +293,18 @@ void bindLocalizationResults(py::module_& m) {
                                if (!l.T_world_base) return py::none();
                                return poseArray(*l.T_world_base);
                              })
-      .def_readonly("translation_error_m", &LocalizationRecord::translation_error_m)
-      .def_readonly("rotation_error_deg", &LocalizationRecord::rotation_error_deg)
+      .def_property_readonly(
+          "translation_error_m",
+          [](const LocalizationRecord& l) {
+            return errorOf(l, &LocalizationRecord::translation_error_m);
+          },
+          "against ground truth, or None without it")
+      .def_property_readonly(
+          "rotation_error_deg",
+          [](const LocalizationRecord& l) {
+            return errorOf(l, &LocalizationRecord::rotation_error_deg);
+          },
+          "against ground truth, or None without it")
       .def_property_readonly(
           "matches",
           [](const LocalizationRecord& l) {
@@ -294,14 +322,34 @@ void bindLocalizationResults(py::module_& m) {
       .def_readonly("refinement_correction_m", &LocalizationRecord::refinement_correction_m)
       .def_readonly("latest_scan", &LocalizationRecord::latest_scan,
                     "localized by the latest scan's own segments (latest_scan_fallback_m)");
-  py::class_<LocalizationSummary>(m, "LocalizationSummary")
-      .def_readonly("localizations", &LocalizationSummary::localizations)
+}
+
+void bindLocalizationResults(py::module_& m) {
+  bindLocalizationRecord(m);
+  py::class_<LocalizationSummary> summary(
+      m, "LocalizationSummary",
+      "Counts and mean errors of a run's localizations; an error or count that ground truth did "
+      "not measure is None");
+  defRepr(summary, "LocalizationSummary",
+          {"localizations", "with_ground_truth", "below_1m", "below_5m", "mean_translation_error_m",
+           "mean_rotation_error_deg"});
+  summary.def_readonly("localizations", &LocalizationSummary::localizations)
+      .def_readonly("with_ground_truth", &LocalizationSummary::with_ground_truth)
       .def_readonly("below_1m", &LocalizationSummary::below_1m)
       .def_readonly("below_5m", &LocalizationSummary::below_5m)
       .def_readonly("mean_translation_error_m", &LocalizationSummary::mean_translation_error_m)
       .def_readonly("mean_rotation_error_deg", &LocalizationSummary::mean_rotation_error_deg);
-  py::class_<LocalizationRun>(m, "LocalizationRun", "A run localized against a target map")
-      .def_readonly("localizations", &LocalizationRun::localizations)
+  py::class_<LocalizationRun> run(m, "LocalizationRun", "A run localized against a target map");
+  run.def("__repr__", [](const LocalizationRun& r) {
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "LocalizationRun(frames=%zu, localizations=%zu, distance_m=%.4g, "
+                  "has_ground_truth=%s)",
+                  r.stats.frames, r.localizations.size(), r.distance_m,
+                  r.trajectory_gt.empty() ? "False" : "True");
+    return std::string(text);
+  });
+  run.def_readonly("localizations", &LocalizationRun::localizations)
       .def_property_readonly("trajectory_gt",
                              [](const LocalizationRun& r) { return posesArray(r.trajectory_gt); })
       .def_property_readonly("trajectory_odom",
@@ -309,8 +357,12 @@ void bindLocalizationResults(py::module_& m) {
       .def_readonly("distance_m", &LocalizationRun::distance_m)
       .def_readonly("odometry_is_ground_truth", &LocalizationRun::odometry_is_ground_truth)
       .def_readonly("stats", &LocalizationRun::stats)
-      .def("summary", [](const LocalizationRun& r) { return summarize(r.localizations); });
-  m.def("summarize", &summarize, py::arg("records"));
+      .def(
+          "summary", [](const LocalizationRun& r) { return summarize(r); },
+          "summarize(localizations), with the counts None too when the run had no ground truth");
+  m.def("summarize",
+        static_cast<LocalizationSummary (*)(const std::vector<LocalizationRecord>&)>(&summarize),
+        py::arg("records"));
 }
 
 void bindLocalization(py::module_& m) {

@@ -112,6 +112,18 @@ class StructBinding {
   std::shared_ptr<std::vector<std::string>> names_;
 };
 
+// "Type(a=1, b=2.5, c=None)": a result's key numbers, read from the attributes named (floats to
+// 4 significant digits, anything else as Python shows it), so that a result printed at the
+// prompt says what it holds instead of its address.
+std::string attributesRepr(const py::object& self, const std::string& type,
+                           const std::vector<std::string>& names);
+template <typename Class>
+Class& defRepr(Class& cls, const char* type, std::vector<std::string> names) {
+  return cls.def("__repr__", [type = std::string(type), names](const py::object& self) {
+    return attributesRepr(self, type, names);
+  });
+}
+
 // Makes an array read-only: views of what the library shares (a target map's descriptors).
 void makeReadOnly(py::array& a);
 

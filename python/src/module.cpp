@@ -6,6 +6,7 @@
 // file as a std::runtime_error naming it, and a stray std::filesystem error takes the same way
 // rather than becoming the one OSError among them.
 #include "bindings.h"
+#include "semsegmap/core/diagnostics.h"
 
 namespace semsegmap::python {
 
@@ -29,6 +30,9 @@ PYBIND11_MODULE(_semsegmap, m) {
   using namespace semsegmap::python;
   m.doc() = "Segment-based semantic localization (SemSegMap): the C++ library's bindings";
   buildFlags(m);
+  // The library's messages name options as the keyword arguments a Python user gives
+  // (odometry=FILE), not as the command line's --odometry FILE.
+  semsegmap::setOptionSpelling(semsegmap::OptionSpelling::kKeyword);
   // In dependency order: a class is registered before any signature that names it.
   bindCore(m);
   bindConfig(m);

@@ -44,6 +44,19 @@ py::array_t<double> posesArray(const std::vector<Pose>& poses) {
   return a;
 }
 
+std::string attributesRepr(const py::object& self, const std::string& type,
+                           const std::vector<std::string>& names) {
+  std::string text = type + "(";
+  for (size_t i = 0; i < names.size(); ++i) {
+    const py::object value = self.attr(names[i].c_str());
+    const py::object shown = py::isinstance<py::float_>(value)
+                                 ? py::str("{:.4g}").attr("format")(value)
+                                 : py::repr(value);
+    text += (i ? ", " : "") + names[i] + "=" + shown.cast<std::string>();
+  }
+  return text + ")";
+}
+
 void makeReadOnly(py::array& a) {
   a.attr("setflags")(py::arg("write") = false);
 }

@@ -1,7 +1,14 @@
-// Colours: classes from the class table, segments by a hash of their index, localizations by
+// Colours: classes from the class table (unknown excepted), segments by a hash of their index, localizations by
 // their error (the bird's-eye pictures' scale: green within 0.5 m, red beyond 5 m).
 
+// Class unknown (id 0: what no camera saw, and all of a LiDAR-only map) is black in the class
+// table, which the overlays draw over camera pictures; on this page's near-black background it
+// would vanish, so here it is a light neutral grey.
+export const UNKNOWN_CLASS = 0;
+export const UNKNOWN_COLOR = [200, 200, 200];
+
 export function classColor(classes, id) {
+  if (id === UNKNOWN_CLASS) return UNKNOWN_COLOR;
   const c = classes.get(id);
   return c ? c.color : [128, 128, 128];
 }

@@ -1,5 +1,6 @@
 // semsegmap view's page: reads the scene embedded in the file, builds the 3D view and the panel,
 // and exposes window.semsegmapViewer for scripts and tests (README.md).
+import { classColor } from './colors.js';
 import { decodeScene } from './scene.js';
 import { Viewer } from './view3d.js';
 import { Panel } from './panel.js';
@@ -46,6 +47,7 @@ function expose(scene, viewer, panel) {
     setColouring: (mode) => viewer.setColouring(mode),
     screenPositionOfLocalization: (i) => viewer.screenPosition(records[i].position),
     matchesOf: (i) => records[i].matches.length,
+    classColour: (id) => classColor(scene.classes, id),
     measureRotation: (ms) => viewer.measureRotation(ms),
     rendered: () => viewer.frames || 0,
   });

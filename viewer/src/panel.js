@@ -12,6 +12,13 @@ function element(tag, attributes = {}, text = '') {
   return e;
 }
 
+// A localization's frame as the dataset names it (its scan's number, when it has one), with
+// the run's index beside it; older scenes have no dataset_frame.
+export function frameName(r) {
+  const own = r.dataset_frame === null || r.dataset_frame === undefined ? null : r.dataset_frame;
+  return own === null ? `${r.frame}` : `${own} (run ${r.frame})`;
+}
+
 function swatch(rgb) {
   return element('span', { class: 'swatch', style: `background:${css(rgb)}` });
 }
@@ -106,7 +113,7 @@ export class Panel {
     this.items = this.records.map((r, i) => {
       const item = element('li', { 'data-index': i });
       item.append(swatch(errorColor(r.error_m)),
-                  ` frame ${r.frame} · ${r.inliers} inliers · ${r.error_m === null ? '?' : fmt(r.error_m)} m`);
+                  ` frame ${frameName(r)} · ${r.inliers} inliers · ${r.error_m === null ? '?' : fmt(r.error_m)} m`);
       item.addEventListener('click', () => this.choose(i));
       list.append(item);
       return item;
@@ -202,7 +209,8 @@ export class Panel {
     box.dataset.matches = r.matches.length;
     const o = this.scene.origin;
     const rows = [
-      ['frame', `${r.frame} (t ${fmt(r.time, 2)} s)`],
+      ['frame', frameName(r)],
+      ['time', r.time === null || r.time === undefined ? 'unknown (not in the data)' : `${fmt(r.time, 3)} s`],
       ['inliers', `${r.inliers}`],
       ['matches shown', this.scene.localization.has_matches ? `${r.matches.length}` : 'none (no matches.csv)'],
       ['position', r.position.map((v, k) => fmt(v + o[k], 2)).join(', ') + ' m'],

@@ -1,5 +1,7 @@
 #include "semsegmap/core/diagnostics.h"
 
+#include <algorithm>
+#include <atomic>
 #include <iostream>
 #include <mutex>
 
@@ -25,7 +27,23 @@ void emit(const std::string& line) {
     std::cerr << line << "\n" << std::flush;
 }
 
+std::atomic<OptionSpelling>& spelling() {
+  static std::atomic<OptionSpelling> s{OptionSpelling::kCommandLine};
+  return s;
+}
+
 }  // namespace
+
+void setOptionSpelling(OptionSpelling s) {
+  spelling() = s;
+}
+
+std::string optionText(const std::string& name, const std::string& value, bool literal) {
+  if (spelling() == OptionSpelling::kCommandLine) return "--" + name + " " + value;
+  std::string keyword = name;
+  std::replace(keyword.begin(), keyword.end(), '-', '_');
+  return keyword + "=" + (literal ? "\"" + value + "\"" : value);
+}
 
 void note(const std::string& text) {
   emit("note: " + text);

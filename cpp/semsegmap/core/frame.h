@@ -32,8 +32,12 @@ struct CameraFrame {
 };
 
 struct Frame {
-  size_t index = 0;
-  double timestamp_s = 0.0;
+  size_t index = 0;  // in the source it came from (a subset numbers its frames from 0)
+  // The dataset's own number of the frame, from its scan's name (KITTI's 000042.bin is 42; see
+  // FrameSource::frameNumber); kept through subsets, so that outputs name the frame as the data
+  // does. Nothing when the dataset does not name its scans by number.
+  std::optional<size_t> number;
+  double timestamp_s = 0.0;  // made up from the rate when !DatasetInfo::has_frame_times
   std::vector<LidarPoint> points;
   std::vector<PointLabel> point_labels;  // empty, or one per point
   // When each point was measured, in seconds after timestamp_s (a spinning LiDAR sweeps while

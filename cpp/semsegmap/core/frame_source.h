@@ -67,6 +67,18 @@ class FrameSource {
   virtual std::optional<size_t> frameNumber(size_t /*index*/) { return std::nullopt; }
 };
 
+// How the dataset itself names a frame, for outputs that a user matches with the data: its
+// number (Frame::number) and its time, each nothing when the data has none (a time made up from
+// the rate is not the data's).
+struct FrameStamp {
+  std::optional<size_t> number;
+  std::optional<double> time_s;
+};
+inline FrameStamp stampOf(const Frame& frame, const DatasetInfo& info) {
+  return {frame.number,
+          info.has_frame_times ? std::optional<double>(frame.timestamp_s) : std::nullopt};
+}
+
 // What every FrameSource throws for an index past its end.
 [[noreturn]] inline void throwFrameOutOfRange(const std::string& dataset, size_t index,
                                               size_t frames) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -15,5 +16,12 @@ std::string jsonText(const nlohmann::ordered_json& json);
 
 // jsonText(json), written atomically (core/atomic_file.h).
 void writeJsonAtomically(const std::filesystem::path& path, const nlohmann::ordered_json& json);
+
+// A value the run does not know (an error without ground truth, a mean of nothing) is null in
+// every result file: a zero there would read as a measurement.
+template <class T>
+nlohmann::ordered_json orNull(const std::optional<T>& value) {
+  return value ? nlohmann::ordered_json(*value) : nlohmann::ordered_json(nullptr);
+}
 
 }  // namespace semsegmap

@@ -210,7 +210,7 @@ std::unique_ptr<FrameSource> openSource(const std::string& spec, const DatasetOp
 std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetOptions& options) {
   auto source = openSource(spec, options);
   if (!options.rig.empty() && dynamic_cast<FolderReader*>(source.get()) == nullptr)
-    throw std::invalid_argument("--rig: dataset '" + spec +
+    throw std::invalid_argument(optionText("rig", "FILE") + ": dataset '" + spec +
                                 "' brings its own calibration; a rig file is for folder: datasets");
   const bool lidar_odometry = options.odometry == "lidar";
   PoseFileOptions poses;
@@ -220,9 +220,9 @@ std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetO
   source = withPoseFiles(std::move(source), poses);
   if (lidar_odometry) source = withLidarOdometry(std::move(source), options.lidar_odometry);
   if (source->info().odometry_is_ground_truth)
-    note(source->info().name +
-         ": its ground-truth poses serve as its odometry too (--odometry FILE or --odometry "
-         "lidar for odometry of its own): errors measured against them are marked so");
+    note(source->info().name + ": its ground-truth poses serve as its odometry too (" +
+         optionText("odometry", "FILE") + " or " + optionText("odometry", "lidar", true) +
+         " for odometry of its own): errors measured against them are marked so");
   if (!options.labels.empty())
     source = withLabelSet(std::move(source), options.labels, options.class_maps_dir,
                           options.frames_to_check);

@@ -26,7 +26,7 @@ fs::path applyKittiCalib(const fs::path& poses_path, const fs::path& explicit_ca
     if (!fs::exists(beside) || !KittiCalibFile(beside).has("Tr")) return {};
     calib = beside;
     note(poses_path.string() + ": KITTI camera-0 poses, turned into LiDAR poses with Tr from " +
-         calib.string() + " (--kitti-calib FILE to choose)");
+         calib.string() + " (" + optionText("kitti-calib", "FILE") + " to choose)");
   }
   const Pose Tr = KittiCalibFile(calib).transform3x4("Tr");
   std::vector<Pose> camera0;

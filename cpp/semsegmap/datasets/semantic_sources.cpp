@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/io/class_map_file.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/label_set.h"
@@ -103,10 +104,10 @@ void checkLabelSetFrames(const LabelSetInfo& set, const std::filesystem::path& d
         std::to_string(set.dataset_frames > 0 ? set.dataset_frames : set.frames) +
         " frames, this one has " + std::to_string(dataset_frames));
   if (set.frames < frames_needed)
-    throw std::runtime_error(
-        dir.string() + ": the label set labels frames 0 to " + std::to_string(set.frames - 1) +
-        " only, this run reads " + std::to_string(frames_needed) +
-        " frames (label them all, or give --max-frames " + std::to_string(set.frames) + ")");
+    throw std::runtime_error(dir.string() + ": the label set labels frames 0 to " +
+                             std::to_string(set.frames - 1) + " only, this run reads " +
+                             std::to_string(frames_needed) + " frames (label them all, or give " +
+                             optionText("max-frames", std::to_string(set.frames)) + ")");
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "semsegmap/eval/experiment.h"
 
+#include <cstdio>
 #include <stdexcept>
 
 #include "semsegmap/io/config.h"
@@ -31,6 +32,18 @@ void forEachFrame(FrameSource& source, const std::string& stage, const Experimen
     use(frame);
     if (progress) progress(stage, i + 1, n);
   }
+}
+
+std::string countText(const std::optional<size_t>& n) {
+  return n ? std::to_string(*n) : "-";
+}
+
+std::string meanErrorText(const std::optional<double>& translation_m,
+                          const std::optional<double>& rotation_deg) {
+  if (!translation_m || !rotation_deg) return "-";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.2f m / %.2f°", *translation_m, *rotation_deg);
+  return text;
 }
 
 }  // namespace semsegmap

@@ -5,9 +5,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "semsegmap/core/frame_source.h"
+#include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
 namespace semsegmap {
@@ -33,5 +35,15 @@ using ExperimentProgress = std::function<void(const std::string& stage, size_t d
 // records by frame number, so frames must come numbered from 0 in order (throws otherwise).
 void forEachFrame(FrameSource& source, const std::string& stage, const ExperimentProgress& progress,
                   const std::function<void(const Frame&)>& use);
+
+// What a results table shows for a count or a mean error the run does not know (no ground
+// truth, no localization): "-", never a zero that would read as a measurement.
+std::string countText(const std::optional<size_t>& n);
+// "0.32 m / 1.19°", or "-".
+std::string meanErrorText(const std::optional<double>& translation_m,
+                          const std::optional<double>& rotation_deg);
+inline std::string meanErrorText(const LocalizationSummary& s) {
+  return meanErrorText(s.mean_translation_error_m, s.mean_rotation_error_deg);
+}
 
 }  // namespace semsegmap

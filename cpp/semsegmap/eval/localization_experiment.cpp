@@ -43,7 +43,7 @@ LocalizationResult resultOf(const LocalizationExperiment& e, const NamedConfig& 
   r.fingerprint = map.map->fingerprint;
   r.run = run_name;
   r.frames = run.stats.frames;
-  r.summary = summarize(run.localizations);
+  r.summary = summarize(run);
   r.hz = run.stats.fps();
   r.per_frame = meanStageTimes(run.stats);
   r.map_segments = map.map->size();
@@ -119,10 +119,10 @@ nlohmann::ordered_json toJson(const LocalizationResult& r) {
           {"frames", r.frames},
           {"distance_m", r.distance_m},
           {"n_localizations", s.localizations},
-          {"n_error_below_1m", s.below_1m},
-          {"n_error_below_5m", s.below_5m},
-          {"mean_translation_error_m", s.mean_translation_error_m},
-          {"mean_rotation_error_deg", s.mean_rotation_error_deg},
+          {"n_error_below_1m", orNull(s.below_1m)},
+          {"n_error_below_5m", orNull(s.below_5m)},
+          {"mean_translation_error_m", orNull(s.mean_translation_error_m)},
+          {"mean_rotation_error_deg", orNull(s.mean_rotation_error_deg)},
           {"n_wrong", r.wrong},
           {"wrong_rate", r.wrong_rate},
           {"recall_along_trajectory", r.recall},
@@ -229,11 +229,10 @@ std::string localizationTable(const LocalizationExperiment& e) {
     const bool semantic = r.config.find("semsegmap") != std::string::npos;
     const int paper_n = semantic ? paper.second : paper.first;
     std::snprintf(line, sizeof(line),
-                  "| %s | %s | %zu | %zu | %zu | %zu | %.2f m / %.2f° | %.2f | %.1f | %zu | %.1f | "
-                  "%s |\n",
-                  r.run.c_str(), r.config.c_str(), r.summary.localizations, r.summary.below_1m,
-                  r.summary.below_5m, r.wrong, r.summary.mean_translation_error_m,
-                  r.summary.mean_rotation_error_deg, r.recall, r.hz, r.map_segments,
+                  "| %s | %s | %zu | %s | %s | %zu | %s | %.2f | %.1f | %zu | %.1f | %s |\n",
+                  r.run.c_str(), r.config.c_str(), r.summary.localizations,
+                  countText(r.summary.below_1m).c_str(), countText(r.summary.below_5m).c_str(),
+                  r.wrong, meanErrorText(r.summary).c_str(), r.recall, r.hz, r.map_segments,
                   static_cast<double>(r.map_bytes) / 1024.0,
                   paper_n >= 0 ? std::to_string(paper_n).c_str() : "-");
     t << line;

@@ -12,7 +12,8 @@ void writeLocalizationPicture(const std::filesystem::path& png, const Localizati
     pic.map_centroids.push_back(s.centroid);
     pic.map_points.insert(pic.map_points.end(), s.points.begin(), s.points.end());
   }
-  pic.trajectory = run.trajectory_gt.empty() ? run.trajectory_odom : run.trajectory_gt;
+  pic.has_ground_truth = !run.trajectory_gt.empty();
+  pic.trajectory = pic.has_ground_truth ? run.trajectory_gt : run.trajectory_odom;
   const LocalizationRecord* best = nullptr;
   for (const LocalizationRecord& r : run.localizations) {
     pic.localizations.emplace_back(r.T_map_base.translation(),

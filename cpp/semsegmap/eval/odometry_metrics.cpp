@@ -81,8 +81,12 @@ KittiRelativeError kittiRelativeError(const std::vector<Pose>& estimate,
 
 nlohmann::ordered_json toJson(const KittiRelativeError& error) {
   nlohmann::ordered_json j;
-  j["translation_percent"] = error.translation_percent;
-  j["rotation_deg_per_100m"] = error.rotation_deg_per_100m;
+  // A trajectory shorter than the shortest length has no segment: the error is unknown.
+  const bool measured = !error.segments.empty();
+  j["translation_percent"] = measured ? nlohmann::ordered_json(error.translation_percent)
+                                      : nlohmann::ordered_json(nullptr);
+  j["rotation_deg_per_100m"] = measured ? nlohmann::ordered_json(error.rotation_deg_per_100m)
+                                        : nlohmann::ordered_json(nullptr);
   j["segments"] = error.segments.size();
   nlohmann::ordered_json lengths = nlohmann::ordered_json::array();
   for (const KittiLengthError& l : error.by_length)

@@ -74,13 +74,16 @@ nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<Odomet
   j["dataset"] = run.dataset;
   j["frames"] = run.frames.size();
   j["seconds"] = run.seconds;
-  j["ms_per_frame"] = run.frames.empty() ? 0.0 : 1e3 * run.seconds / run.frames.size();
+  j["ms_per_frame"] = run.frames.empty()
+                          ? nlohmann::ordered_json(nullptr)
+                          : nlohmann::ordered_json(1e3 * run.seconds / run.frames.size());
   j["diagnostics"] = fallbackCounts(run.frames);
-  if (errors) {
-    j["kitti_relative_error"] = toJson(errors->kitti);
-    j["ate"] = toJson(errors->ate);
-    j["ate_aligned"] = toJson(errors->ate_aligned);
-  }
+  // Without ground truth the errors are unknown: null, as in every summary.
+  using Json = nlohmann::ordered_json;
+  j["has_ground_truth"] = errors.has_value();
+  j["kitti_relative_error"] = errors ? toJson(errors->kitti) : Json(nullptr);
+  j["ate"] = errors ? toJson(errors->ate) : Json(nullptr);
+  j["ate_aligned"] = errors ? toJson(errors->ate_aligned) : Json(nullptr);
   return j;
 }
 

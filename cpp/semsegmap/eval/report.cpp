@@ -44,9 +44,9 @@ std::string localizationVerdict(const LocalizationExperiment& e) {
     if (!sem || !seg) continue;
     const auto paper = paperLocalizations(run, e.config.preset);
     t << "- " << run << ": " << sem->config << " localized " << sem->summary.localizations
-      << " times (" << sem->summary.below_1m << " within 1 m, " << sem->wrong << " wrong), "
-      << seg->config << " " << seg->summary.localizations << " (" << seg->summary.below_1m << ", "
-      << seg->wrong << " wrong)";
+      << " times (" << countText(sem->summary.below_1m) << " within 1 m, " << sem->wrong
+      << " wrong), " << seg->config << " " << seg->summary.localizations << " ("
+      << countText(seg->summary.below_1m) << ", " << seg->wrong << " wrong)";
     if (seg->summary.localizations > 0)
       t << ": "
         << fixed(static_cast<double>(sem->summary.localizations) /

@@ -214,6 +214,7 @@ void appendRun(LocalizationRun& all, LocalizationRun run) {
                            run.trajectory_gt.end());
   all.trajectory_odom.insert(all.trajectory_odom.end(), run.trajectory_odom.begin(),
                              run.trajectory_odom.end());
+  all.frames.insert(all.frames.end(), run.frames.begin(), run.frames.end());
   all.distance_m += run.distance_m;
   all.stats.frames += run.stats.frames;
   all.stats.total += run.stats.total;
@@ -256,21 +257,30 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
   }
 }
 
+namespace {
+using Json = nlohmann::ordered_json;
+// A registered error is negative where the scan did not register: unknown, so null.
+Json known(double value) {
+  return value >= 0 ? Json(value) : Json(nullptr);
+}
+}  // namespace
+
 nlohmann::ordered_json toJson(const RevisitResult& r) {
+  const bool compared = r.registered_compared > 0;
   nlohmann::ordered_json loc = nlohmann::ordered_json::array();
   for (const RevisitLocalization& l : r.localizations)
     loc.push_back({{"frame", l.frame},
                    {"inliers", l.inliers},
                    {"translation_error_m", l.translation_error_m},
                    {"rotation_error_deg", l.rotation_error_deg},
-                   {"registered_error_m", l.registered_error_m},
-                   {"registered_rotation_error_deg", l.registered_rotation_error_deg}});
+                   {"registered_error_m", known(l.registered_error_m)},
+                   {"registered_rotation_error_deg", known(l.registered_rotation_error_deg)}});
   nlohmann::ordered_json wake = nlohmann::ordered_json::array();
   for (const WakeUp& w : r.wake_ups)
     wake.push_back({{"first", w.frames.first},
                     {"last", w.frames.last},
                     {"revisit", w.revisit},
-                    {"localized_at_frame", w.localized},
+                    {"localized_at_frame", w.localized > 0 ? Json(w.localized) : Json(nullptr)},
                     {"wrong_first", w.wrong_first}});
   return {{"config", r.config},
           {"descriptor", r.descriptor},
@@ -283,13 +293,14 @@ nlohmann::ordered_json toJson(const RevisitResult& r) {
           {"n_error_below_1m", r.below_1m},
           {"n_error_below_5m", r.below_5m},
           {"n_wrong", r.wrong},
-          {"mean_translation_error_m", r.mean_translation_error_m},
-          {"mean_rotation_error_deg", r.mean_rotation_error_deg},
+          {"mean_translation_error_m", orNull(r.mean_translation_error_m)},
+          {"mean_rotation_error_deg", orNull(r.mean_rotation_error_deg)},
           {"n_revisits_localized", r.revisits_localized},
           {"n_registered_compared", r.registered_compared},
           {"n_registered_below_0_3m", r.registered_below_0_3m},
-          {"mean_registered_error_m", r.mean_registered_error_m},
-          {"mean_registered_rotation_error_deg", r.mean_registered_rotation_error_deg},
+          {"mean_registered_error_m", compared ? Json(r.mean_registered_error_m) : Json(nullptr)},
+          {"mean_registered_rotation_error_deg",
+           compared ? Json(r.mean_registered_rotation_error_deg) : Json(nullptr)},
           {"dir", r.dir.string()},
           {"wake_ups", wake},
           {"localizations", loc}};
@@ -305,10 +316,17 @@ std::vector<double> errorsOf(const RevisitResult& r) {
 std::string groundTruthCheckText(const RevisitExperiment& e) {
   char line[512];
   std::snprintf(line, sizeof line,
-                "\nground truth check: %zu of %zu query scans registered to the mapped scans; "
-                "registration moved their ground truth by %.2f m on average (at most %.2f m)\n",
-                e.registered, e.queries.size(), e.mean_correction_m, e.max_correction_m);
+                "\nground truth check: %zu of %zu query scans registered to the mapped scans",
+                e.registered, e.queries.size());
   std::string out = line;
+  // With none registered, no correction was measured: no "0.00 m on average".
+  if (e.registered > 0) {
+    std::snprintf(line, sizeof line,
+                  "; registration moved their ground truth by %.2f m on average (at most %.2f m)",
+                  e.mean_correction_m, e.max_correction_m);
+    out += line;
+  }
+  out += "\n";
   for (const RevisitResult& r : e.results) {
     std::snprintf(line, sizeof line,
                   "%s: against the registered ground truth, %zu of %zu localizations within "
@@ -448,8 +466,10 @@ nlohmann::ordered_json toJson(const RevisitExperiment& e) {
   j["queries"] = nlohmann::ordered_json::array();
   j["check_ground_truth"] = e.config.check_ground_truth;
   j["n_registered"] = e.registered;
-  j["mean_ground_truth_correction_m"] = e.mean_correction_m;
-  j["max_ground_truth_correction_m"] = e.max_correction_m;
+  // Nothing registered: no correction measured, not a zero one.
+  const bool registered = e.registered > 0;
+  j["mean_ground_truth_correction_m"] = registered ? Json(e.mean_correction_m) : Json(nullptr);
+  j["max_ground_truth_correction_m"] = registered ? Json(e.max_correction_m) : Json(nullptr);
   for (const RevisitFrame& q : e.queries) {
     nlohmann::ordered_json f = {
         {"frame", q.frame}, {"nearest_mapped_m", q.nearest_mapped_m}, {"revisit", q.revisit}};
@@ -487,14 +507,13 @@ std::string revisitTable(const RevisitExperiment& e) {
   t << "| config | localizations | < 0.5 m | < 1 m | < 5 m | wrong (> " << e.config.wrong_m
     << " m) | mean error | revisits localized (< " << e.config.correct_m << " m) |\n"
     << "| --- | ---: | ---: | ---: | ---: | ---: | --- | ---: |\n";
-  char line[512], mean[64];
+  char line[512];
   for (const RevisitResult& r : e.results) {
-    // No localization has no mean error, not a zero one.
-    std::snprintf(mean, sizeof(mean), "%.2f m / %.2f°", r.mean_translation_error_m,
-                  r.mean_rotation_error_deg);
     std::snprintf(line, sizeof(line), "| %s | %zu | %zu | %zu | %zu | %zu | %s | %zu of %zu |\n",
                   r.config.c_str(), r.localizations.size(), r.below_0_5m, r.below_1m, r.below_5m,
-                  r.wrong, r.localizations.empty() ? "-" : mean, r.revisits_localized, e.revisits);
+                  r.wrong,
+                  meanErrorText(r.mean_translation_error_m, r.mean_rotation_error_deg).c_str(),
+                  r.revisits_localized, e.revisits);
     t << line;
   }
   if (e.odometry_is_ground_truth)

@@ -85,7 +85,7 @@ struct RevisitResult {  // one configuration
   uint64_t map_bytes = 0;
   std::vector<RevisitLocalization> localizations;
   size_t below_0_5m = 0, below_1m = 0, below_5m = 0, wrong = 0;
-  double mean_translation_error_m = 0.0, mean_rotation_error_deg = 0.0;
+  std::optional<double> mean_translation_error_m, mean_rotation_error_deg;  // none: unknown
   size_t revisits_localized = 0;  // revisit frames localized within correct_m
   std::vector<WakeUp> wake_ups;   // with wake-ups only
   // check_ground_truth: localizations with a registered ground truth, and their errors to it.

@@ -182,8 +182,8 @@ FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : 
   } else {
     rig.rig.lidar.hfov_deg = 360.0;
     rig.rig.rate_hz = 10.0;  // as a rig file without rate_hz
-    note(dir_.string() + " has no rig file (rig.yaml, or --rig FILE): LiDAR only at " +
-         shownNumber(rig.rig.rate_hz) + " Hz, the base frame is the LiDAR");
+    note(dir_.string() + " has no rig file (rig.yaml, or " + optionText("rig", "FILE") +
+         "): LiDAR only at " + shownNumber(rig.rig.rate_hz) + " Hz, the base frame is the LiDAR");
   }
   info_.name = !rig.name.empty() ? rig.name : "folder:" + fs::absolute(dir_).filename().string();
   info_.rig = rig.rig;
@@ -305,6 +305,7 @@ Frame FolderReader::frame(size_t index) {
   if (index >= scans_.size()) throwFrameOutOfRange(info_.name, index, scans_.size());
   Frame f;
   f.index = index;
+  f.number = frameNumber(index);
   f.timestamp_s = times_[index];
   DecodedPoints scan = readPointCloudFile(scans_[index]);
   f.points = std::move(scan.points);

@@ -183,6 +183,7 @@ Frame KittiRawReader::frame(size_t index) {
   if (index >= frames_.size()) throwFrameOutOfRange(info_.name, index, frames_.size());
   const FrameFiles& files = frames_[index];
   Frame f = kittiScanFrame(index, files.timestamp_s, files.scan);
+  f.number = files.number;
 
   Image rgb = readPng(files.image);
   const Camera& cam = info_.rig.cameras.front();

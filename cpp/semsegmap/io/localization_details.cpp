@@ -7,6 +7,7 @@
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/io/csv_table.h"
+#include "semsegmap/io/run_output.h"
 
 namespace semsegmap {
 
@@ -35,16 +36,19 @@ void writeMatchesCsv(const std::filesystem::path& path, const LocalizationRun& r
 }
 
 // Frames are numbered from 0 in the order they are run (the localization records carry the
-// same numbers), so row i is frame i.
+// same numbers), so row i is frame i; beside it the dataset's own number and time, as in
+// localizations.csv.
 void writeTrajectoryCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   const bool gt = run.trajectory_gt.size() == run.trajectory_odom.size();
+  const bool named = run.frames.size() == run.trajectory_odom.size();
   writeFileAtomically(path, [&](std::ostream& out) {
-    out << "frame";
+    out << "frame,dataset_frame,timestamp";
     for (const char* who : {"odom", "gt"})
       for (const char* f : {"x", "y", "z", "qx", "qy", "qz", "qw"}) out << ',' << who << '_' << f;
     out << '\n';
     for (size_t i = 0; i < run.trajectory_odom.size(); ++i)
-      out << i << poseFields(run.trajectory_odom[i])
+      out << i << (named ? frameStampFields(run.frames[i].number, run.frames[i].time_s) : ",,")
+          << poseFields(run.trajectory_odom[i])
           << (gt ? poseFields(run.trajectory_gt[i]) : ",,,,,,,") << '\n';
   });
 }
@@ -64,12 +68,18 @@ Pose poseFrom(const CsvTable& t, size_t row, const std::array<size_t, 7>& column
   return fromXyzQuat(v);
 }
 
+// A whole number >= 0 in an optional column; nothing when the column or the field is empty.
+std::optional<size_t> optionalCount(const CsvTable& t, size_t row, const char* name) {
+  if (!t.has(name) || t.text(row, t.column(name)).empty()) return std::nullopt;
+  return t.count(row, t.column(name));
+}
+
 std::vector<LocalizationRow> readLocalizations(const std::filesystem::path& path) {
   const CsvTable t = CsvTable::read(path);
-  const size_t frame = t.column("frame"), time = t.column("timestamp"),
-               inliers = t.column("inliers");
+  const size_t frame = t.column("frame"), inliers = t.column("inliers");
   const auto pose = poseColumns(t, "");
-  // Older files have no refinement_m; a run without ground truth leaves the errors empty.
+  // Older files have no refinement_m or dataset_frame; a run without ground truth leaves the
+  // errors empty, a dataset without times (from version 2) the timestamp.
   const auto optional = [&](size_t row, const char* name) -> std::optional<double> {
     return t.has(name) ? t.optionalNumber(row, t.column(name)) : std::nullopt;
   };
@@ -77,7 +87,8 @@ std::vector<LocalizationRow> readLocalizations(const std::filesystem::path& path
   for (size_t i = 0; i < t.rows(); ++i) {
     LocalizationRow& r = rows[i];
     r.frame = t.count(i, frame);
-    r.timestamp_s = t.number(i, time);
+    r.dataset_frame = optionalCount(t, i, "dataset_frame");
+    r.timestamp_s = optional(i, "timestamp");
     r.T_map_base = poseFrom(t, i, pose);
     r.inliers = static_cast<int>(t.count(i, inliers));
     r.translation_error_m = optional(i, "translation_error_m");
@@ -109,6 +120,9 @@ std::vector<TrajectoryRow> readTrajectory(const std::filesystem::path& path) {
   std::vector<TrajectoryRow> rows(t.rows());
   for (size_t i = 0; i < t.rows(); ++i) {
     rows[i].frame = t.count(i, frame);
+    rows[i].dataset_frame = optionalCount(t, i, "dataset_frame");
+    rows[i].timestamp_s =
+        t.has("timestamp") ? t.optionalNumber(i, t.column("timestamp")) : std::nullopt;
     rows[i].T_odom_base = poseFrom(t, i, odom);
     if (!t.text(i, gt[0]).empty()) rows[i].T_world_base = poseFrom(t, i, gt);
   }
@@ -121,6 +135,7 @@ void readSummary(const std::filesystem::path& path, LocalizationFolder& f) {
     f.dataset = j.value("dataset", "");
     f.map = j.value("map", "");
     f.config = j.value("config", "");
+    f.schema = j.value("schema", "semsegmap.localization/1");  // older files do not say
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(path.string() + ": not a run's summary (" + e.what() + ")");
   }

@@ -13,18 +13,32 @@
 
 namespace semsegmap {
 
+std::string frameStampFields(const std::optional<size_t>& number,
+                             const std::optional<double>& time_s) {
+  char text[64];
+  std::snprintf(text, sizeof(text), ",%s,", number ? std::to_string(*number).c_str() : "");
+  std::string fields = text;
+  if (time_s) {
+    std::snprintf(text, sizeof(text), "%.6f", *time_s);
+    fields += text;
+  }
+  return fields;
+}
+
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
+    // The columns of schema semsegmap.localization/2 (summary.json; docs/commands.md), read by
+    // name: dataset_frame and an empty timestamp are what version 1 lacked.
     // refinement_m: how far pose refinement moved the pose; empty where it was not applied.
     // latest_scan: 1 where the latest scan's own segments localized (latest_scan_fallback_m).
-    out << "frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,rotation_error_deg,"
-           "refinement_m,latest_scan\n";
+    out << "frame,dataset_frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,"
+           "rotation_error_deg,refinement_m,latest_scan\n";
     char line[512];
     for (const LocalizationRecord& r : run.localizations) {
       const auto v = toXyzQuat(r.T_map_base);
-      std::snprintf(line, sizeof(line), "%zu,%.6f,%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%d",
-                    r.frame_index, r.timestamp_s, v[0], v[1], v[2], v[3], v[4], v[5], v[6],
-                    r.inliers);
+      out << r.frame_index << frameStampFields(r.frame_number, r.timestamp_s);
+      std::snprintf(line, sizeof(line), ",%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%d", v[0], v[1], v[2],
+                    v[3], v[4], v[5], v[6], r.inliers);
       out << line;
       if (r.T_world_base) {
         std::snprintf(line, sizeof(line), ",%.4f,%.4f", r.translation_error_m,
@@ -62,8 +76,10 @@ nlohmann::ordered_json stageMsJson(const StageTimes& t, bool with_total) {
 }
 
 std::string localizationSummaryJson(const LocalizationRun& run, const SummaryContext& c) {
-  const LocalizationSummary s = summarize(run.localizations);
+  const LocalizationSummary s = summarize(run);
   nlohmann::ordered_json j;
+  // The layout of this file and of localizations.csv beside it (docs/commands.md).
+  j["schema"] = kLocalizationSchema;
   j["dataset"] = c.dataset;
   j["map"] = c.map;
   j["config"] = c.config;
@@ -74,16 +90,14 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   // The errors below measured against the very poses the local map was built on.
   j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
   j["n_localizations"] = s.localizations;
-  j["n_error_below_1m"] = s.below_1m;
-  j["n_error_below_5m"] = s.below_5m;
+  j["n_with_ground_truth"] = s.with_ground_truth;
+  // Without ground truth (or without a localization) the errors are unknown: null, not zero.
+  j["n_error_below_1m"] = orNull(s.below_1m);
+  j["n_error_below_5m"] = orNull(s.below_5m);
   j["n_refined"] = std::count_if(run.localizations.begin(), run.localizations.end(),
                                  [](const LocalizationRecord& r) { return r.refined; });
-  // No localization, or no ground truth: the errors are unknown, not zero (which reads as perfect).
-  const bool errors_known = s.localizations > 0 && !run.trajectory_gt.empty();
-  j["mean_translation_error_m"] =
-      errors_known ? nlohmann::ordered_json(s.mean_translation_error_m) : nullptr;
-  j["mean_rotation_error_deg"] =
-      errors_known ? nlohmann::ordered_json(s.mean_rotation_error_deg) : nullptr;
+  j["mean_translation_error_m"] = orNull(s.mean_translation_error_m);
+  j["mean_rotation_error_deg"] = orNull(s.mean_rotation_error_deg);
   j["fps"] = run.stats.fps();
   j["stage_ms"] = stageMsJson(meanStageTimes(run.stats), true);
   j["map_segments"] = c.map_segments;
@@ -123,14 +137,18 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
   j["fps"] = run.stats.fps();
   j["graph_ms_total"] = run.graph_ms;
   const std::optional<SlamErrors> errors = slamErrors(run);
-  if (errors) {
-    j["ate_odometry"] = errorJson(errors->odometry);
-    j["ate_slam"] = errorJson(errors->slam);
-    j["ate_odometry_aligned"] = errorJson(errors->odometry_aligned);
-    j["ate_slam_aligned"] = errorJson(errors->slam_aligned);
-  }
+  // Without ground truth the errors are unknown: null, as in every summary.
+  const auto ate = [&](const TrajectoryError SlamErrors::*which) {
+    return errors ? errorJson((*errors).*which) : nlohmann::ordered_json(nullptr);
+  };
+  j["ate_odometry"] = ate(&SlamErrors::odometry);
+  j["ate_slam"] = ate(&SlamErrors::slam);
+  j["ate_odometry_aligned"] = ate(&SlamErrors::odometry_aligned);
+  j["ate_slam_aligned"] = ate(&SlamErrors::slam_aligned);
   j["has_ground_truth"] = errors.has_value();
   j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
+  // false: the TUM files' times are made up from the rate, not the data's.
+  j["has_frame_times"] = run.has_frame_times;
   return jsonText(j);
 }
 

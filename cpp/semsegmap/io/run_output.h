@@ -16,9 +16,21 @@
 
 namespace semsegmap {
 
-// frame, timestamp, T_map_base as x y z qx qy qz qw, inliers, and with ground truth the
-// translation error in m and the rotation error in degrees.
+// The version of localizations.csv and summary.json, named in summary.json: 2 added the
+// dataset's own frame number and left a time the data does not have empty (1 made one up), and
+// writes null for every error or count the run does not know.
+inline constexpr const char* kLocalizationSchema = "semsegmap.localization/2";
+
+// frame (the run's index), dataset_frame (the dataset's own number, empty when it has none),
+// timestamp (the data's, empty when it has none), T_map_base as x y z qx qy qz qw, inliers, with
+// ground truth the translation error in m and the rotation error in degrees, refinement_m and
+// latest_scan.
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run);
+
+// ",NUMBER,TIME" with either field empty when unknown: the dataset's name of a frame as the
+// per-frame CSV files write it after the run's index.
+std::string frameStampFields(const std::optional<size_t>& number,
+                             const std::optional<double>& time_s);
 
 // The mean time per frame of each stage.
 StageTimes meanStageTimes(const RunStats& stats);

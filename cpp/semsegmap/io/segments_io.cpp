@@ -3,6 +3,7 @@
 #include <cstring>
 #include <iomanip>
 #include <ostream>
+#include <string>
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/io/ply_writer.h"
@@ -10,10 +11,16 @@
 namespace semsegmap {
 
 void writeSegmentsCsv(const std::filesystem::path& path, const std::vector<Segment>& segments,
-                      const ClassTable& classes, bool has_ground_truth) {
+                      const ClassTable& classes, bool has_ground_truth,
+                      const std::vector<std::optional<size_t>>& frame_numbers) {
+  const auto number = [&](size_t frame) {
+    return frame < frame_numbers.size() && frame_numbers[frame]
+               ? std::to_string(*frame_numbers[frame])
+               : std::string();
+  };
   writeFileAtomically(path, [&](std::ostream& out) {
     out << "id,observations,points,centroid_x,centroid_y,centroid_z,class,first_frame,last_frame,"
-           "gt_instance,gt_purity\n";
+           "first_dataset_frame,last_dataset_frame,gt_instance,gt_purity\n";
     out << std::fixed;
     for (const auto& s : segments) {
       const SegmentObservation& o = s.last();
@@ -21,7 +28,8 @@ void writeSegmentsCsv(const std::filesystem::path& path, const std::vector<Segme
           classes.contains(o.majority_class) ? classes.at(o.majority_class).name : "unknown";
       out << s.id << ',' << s.observations.size() << ',' << o.n_points << ','
           << std::setprecision(3) << o.centroid.x() << ',' << o.centroid.y() << ','
-          << o.centroid.z() << ',' << cls << ',' << s.first_frame << ',' << s.last_frame << ',';
+          << o.centroid.z() << ',' << cls << ',' << s.first_frame << ',' << s.last_frame << ','
+          << number(s.first_frame) << ',' << number(s.last_frame) << ',';
       if (has_ground_truth)
         out << o.gt_instance << ',' << std::setprecision(4) << o.gt_purity;
       else

@@ -2,7 +2,9 @@
 // the final observations' points as PLY with a segment id per point.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "semsegmap/core/class_table.h"
@@ -10,10 +12,13 @@
 
 namespace semsegmap {
 
-// Columns: id, observations, points, centroid_x/y/z, class, first_frame, last_frame,
-// gt_instance, gt_purity (the last two empty without ground truth). Atomic write.
+// Columns: id, observations, points, centroid_x/y/z, class, first_frame, last_frame (the run's
+// frame indices), first_dataset_frame, last_dataset_frame (the dataset's own numbers of those
+// frames, `frame_numbers[index]`; empty where it has none), gt_instance, gt_purity (empty
+// without ground truth). Atomic write.
 void writeSegmentsCsv(const std::filesystem::path& path, const std::vector<Segment>& segments,
-                      const ClassTable& classes, bool has_ground_truth);
+                      const ClassTable& classes, bool has_ground_truth,
+                      const std::vector<std::optional<size_t>>& frame_numbers = {});
 
 // Binary little-endian PLY: x y z float, red green blue uchar, class ushort, segment int.
 void writeSegmentPointsPly(const std::filesystem::path& path, const std::vector<Segment>& segments);

@@ -168,6 +168,7 @@ Frame SemanticKittiReader::frame(size_t index) {
   if (index >= frames_.size()) throwFrameOutOfRange(info_.name, index, frames_.size());
   const FrameFiles& files = frames_[index];
   Frame f = kittiScanFrame(index, files.timestamp_s, files.scan);
+  f.number = files.number;
   if (!files.labels.empty()) {
     f.point_labels = readLabelBin(files.labels);
     if (f.point_labels.size() != f.points.size())

@@ -198,6 +198,7 @@ void LocalizationSession::process(const Frame& frame) {
           : (r.T_local_base.translation() - run_.trajectory_odom.back().translation()).norm();
   run_.distance_m += moved;
   run_.trajectory_odom.push_back(r.T_local_base);
+  run_.frames.push_back(stampOf(frame, info_));
   if (frame.T_world_base) run_.trajectory_gt.push_back(*frame.T_world_base);
   const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
   if (frames_++ % every == 0) {
@@ -256,7 +257,9 @@ void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, con
   const Localization& l = *a.found;
   LocalizationRecord rec;
   rec.frame_index = frame.index;
-  rec.timestamp_s = frame.timestamp_s;
+  const FrameStamp stamp = stampOf(frame, info_);
+  rec.frame_number = stamp.number;
+  rec.timestamp_s = stamp.time_s;
   rec.T_map_base = T_map_base;
   rec.inliers = l.inliers;
   rec.candidates = l.candidates;
@@ -290,19 +293,30 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {
   LocalizationSummary s;
   s.localizations = records.size();
-  size_t with_gt = 0;
+  size_t below_1m = 0, below_5m = 0;
+  double translation = 0.0, rotation = 0.0;
   for (const LocalizationRecord& r : records) {
     if (!r.T_world_base) continue;
-    ++with_gt;
-    s.below_1m += r.translation_error_m < 1.0;
-    s.below_5m += r.translation_error_m < 5.0;
-    s.mean_translation_error_m += r.translation_error_m;
-    s.mean_rotation_error_deg += r.rotation_error_deg;
+    ++s.with_ground_truth;
+    below_1m += r.translation_error_m < 1.0;
+    below_5m += r.translation_error_m < 5.0;
+    translation += r.translation_error_m;
+    rotation += r.rotation_error_deg;
   }
-  if (with_gt > 0) {
-    s.mean_translation_error_m /= static_cast<double>(with_gt);
-    s.mean_rotation_error_deg /= static_cast<double>(with_gt);
+  if (s.with_ground_truth == s.localizations) {
+    s.below_1m = below_1m;
+    s.below_5m = below_5m;
   }
+  if (s.with_ground_truth > 0) {
+    s.mean_translation_error_m = translation / static_cast<double>(s.with_ground_truth);
+    s.mean_rotation_error_deg = rotation / static_cast<double>(s.with_ground_truth);
+  }
+  return s;
+}
+
+LocalizationSummary summarize(const LocalizationRun& run) {
+  LocalizationSummary s = summarize(run.localizations);
+  if (run.trajectory_gt.empty()) s.below_1m = s.below_5m = std::nullopt;
   return s;
 }
 

@@ -78,8 +78,9 @@ MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSou
                       std::shared_ptr<Describer> describer, const RunOptions& options = {});
 
 struct LocalizationRecord {
-  size_t frame_index = 0;
-  double timestamp_s = 0.0;
+  size_t frame_index = 0;              // in the run, from 0 (Frame::index)
+  std::optional<size_t> frame_number;  // the dataset's own (Frame::number), when it has one
+  std::optional<double> timestamp_s;   // the data's time; nothing when it has none (FrameStamp)
   Pose T_map_base = Pose::Identity();  // T_map_local * T_local_base
   int inliers = 0;
   size_t candidates = 0;
@@ -100,6 +101,7 @@ struct LocalizationRun {
   std::vector<LocalizationRecord> localizations;
   std::vector<Pose> trajectory_gt;    // empty without ground truth
   std::vector<Pose> trajectory_odom;  // the robot's own estimate, in its odometry frame
+  std::vector<FrameStamp> frames;     // per frame run (as trajectory_odom): the data's names
   double distance_m = 0.0;            // driven, by odometry
   // The odometry was the ground truth itself (DatasetInfo): the errors say how the run does
   // with perfect odometry, and the summaries mark them so.
@@ -150,9 +152,16 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
                                 MapSettingsCheck settings = MapSettingsCheck::kRefuse);
 
 struct LocalizationSummary {
-  size_t localizations = 0, below_1m = 0, below_5m = 0;
-  double mean_translation_error_m = 0.0, mean_rotation_error_deg = 0.0;
+  size_t localizations = 0;
+  size_t with_ground_truth = 0;  // localizations whose frame had a ground-truth pose
+  // Unknown (empty) rather than zero, which would read as "none within 1 m" or as perfect: the
+  // counts when a localization had no ground truth, the means when none had.
+  std::optional<size_t> below_1m, below_5m;
+  std::optional<double> mean_translation_error_m, mean_rotation_error_deg;
 };
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records);
+// The same, and the counts unknown too when the run had no ground truth at all (no
+// localization then does not mean none was wrong).
+LocalizationSummary summarize(const LocalizationRun& run);
 
 }  // namespace semsegmap

@@ -43,9 +43,9 @@ Pipeline::Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSo
   // would stack all scans in one place and still exit 0.
   if (poses == PoseSource::kOdometry && !info.has_odometry)
     throw std::runtime_error(
-        "dataset " + info.name +
-        " has no odometry: give --odometry FILE (TUM or KITTI poses) or --odometry lidar" +
-        (info.has_ground_truth_poses ? ", or --poses gt" : ""));
+        "dataset " + info.name + " has no odometry: give " + optionText("odometry", "FILE") +
+        " (TUM or KITTI poses) or " + optionText("odometry", "lidar", true) +
+        (info.has_ground_truth_poses ? ", or " + optionText("poses", "gt", true) : ""));
 }
 
 void Pipeline::describe(const std::vector<SegmentId>& ids, size_t frame_index) {
@@ -147,7 +147,8 @@ FrameResult Pipeline::process(const Frame& frame) {
   if (poses_ == PoseSource::kGroundTruth) {
     if (!frame.T_world_base)
       throw std::runtime_error("frame " + std::to_string(frame.index) +
-                               " has no ground-truth pose (use --poses odom)");
+                               " has no ground-truth pose (use " +
+                               optionText("poses", "odom", true) + ")");
     r.T_local_base = *frame.T_world_base;
   } else {
     r.T_local_base = frame.T_odom_base;

@@ -24,6 +24,7 @@ class SlamSession {
         localizer_(emptyMap(requireDescriber(describer, "SlamSession")),
                    config.localization.localizer) {
     run_.odometry_is_ground_truth = info.odometry_is_ground_truth;
+    run_.has_frame_times = info.has_frame_times;
   }
 
   void process(const Frame& frame) {

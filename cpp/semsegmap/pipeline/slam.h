@@ -30,6 +30,9 @@ struct SlamRun {
   double graph_ms = 0.0;  // pose graph optimization, summed
   // The odometry was the ground truth itself (DatasetInfo): its error says nothing.
   bool odometry_is_ground_truth = false;
+  // The frames' times (the StampedPoses') are the data's; false: made up from the rate
+  // (DatasetInfo::has_frame_times), so that no other file can be matched to them by time.
+  bool has_frame_times = true;
 };
 
 SlamRun runSlam(FrameSource& source, const PipelineConfig& config,

@@ -20,20 +20,34 @@ cv::Scalar errorColor(double e) {
   return {40, 40, 230};
 }
 
-// The title, the error colours at the bottom left and what the picture shows.
+// One entry of the legend at the bottom left, `row` lines up from the last.
+void drawLegendEntry(cv::Mat& canvas, int row, const cv::Scalar& colour, const std::string& text) {
+  const int y = canvas.rows - 30 - 20 * row;
+  cv::circle(canvas, {20, y}, 6, colour, cv::FILLED);
+  drawLabel(canvas, text, {32, y + 5}, 0.5);
+}
+
+// The title, what the dots' colours mean at the bottom left and what the picture shows. Without
+// ground truth no error is known: one entry in the colour every dot has, no error scale.
 void drawLegend(cv::Mat& canvas, const LocalizationPicture& pic, double mpp) {
   drawLabel(canvas, pic.title, {12, 28}, 0.7);
-  const int y0 = canvas.rows - 20;
-  cv::circle(canvas, {20, y0 - 50}, 6, errorColor(0.5), cv::FILLED);
-  drawLabel(canvas, "error < 1 m", {32, y0 - 45}, 0.5);
-  cv::circle(canvas, {20, y0 - 30}, 6, errorColor(3.0), cv::FILLED);
-  drawLabel(canvas, "1-5 m", {32, y0 - 25}, 0.5);
-  cv::circle(canvas, {20, y0 - 10}, 6, errorColor(10.0), cv::FILLED);
-  drawLabel(canvas, "> 5 m", {32, y0 - 5}, 0.5);
-  char scale[96];
+  const bool unknown = std::any_of(pic.localizations.begin(), pic.localizations.end(),
+                                   [](const auto& l) { return l.second < 0; });
+  if (!pic.has_ground_truth) {
+    drawLegendEntry(canvas, 0, errorColor(-1.0), "localization (no ground truth)");
+  } else {
+    const int first = unknown ? 1 : 0;  // a frame without ground truth in a run with it
+    if (unknown) drawLegendEntry(canvas, 0, errorColor(-1.0), "no ground truth");
+    drawLegendEntry(canvas, first, errorColor(10.0), "> 5 m");
+    drawLegendEntry(canvas, first + 1, errorColor(3.0), "1-5 m");
+    drawLegendEntry(canvas, first + 2, errorColor(0.5), "error < 1 m");
+  }
+  char scale[160];
   std::snprintf(scale, sizeof(scale),
-                "grey: %zu map segments; magenta: matches of one localization; %.2f m/px",
-                pic.map_centroids.size(), mpp);
+                "grey: %zu map segments; white: %s; magenta: matches of one localization; "
+                "%.2f m/px",
+                pic.map_centroids.size(),
+                pic.has_ground_truth ? "ground-truth trajectory" : "odometry (its own frame)", mpp);
   drawLabel(canvas, scale, {12, 52}, 0.5);
 }
 

@@ -19,6 +19,9 @@ struct LocalizationPicture {
   std::vector<Eigen::Vector3f> map_points;  // segment points when the map kept them
   std::vector<Eigen::Vector3f> map_centroids;
   std::vector<Pose> trajectory;  // the query run (ground truth when known)
+  // Whether the run had ground truth: else the legend has no error colours (every dot is of the
+  // unknown-error colour) and the trajectory is the odometry, in its own frame.
+  bool has_ground_truth = true;
   // Estimated positions and their translation errors (negative: unknown).
   std::vector<std::pair<Eigen::Vector3d, double>> localizations;
   // The highlighted localization: its position and its matches (local centroid carried into the

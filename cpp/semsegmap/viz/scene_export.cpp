@@ -150,8 +150,10 @@ Json localizationRecordJson(const LocalizationRow& l, const std::vector<const Ma
     for (const auto& t : xyz(m->target.cast<double>(), origin)) pair.push_back(t);
     pairs.push_back(std::move(pair));
   }
+  // The dataset's own frame number and time beside the run's index; null where it has none.
   return {{"frame", l.frame},
-          {"time", mm(l.timestamp_s)},
+          {"dataset_frame", l.dataset_frame ? Json(*l.dataset_frame) : Json(nullptr)},
+          {"time", optionalNumber(l.timestamp_s)},
           {"position", xyz(l.T_map_base.translation(), origin)},
           {"quaternion", {v[3], v[4], v[5], v[6]}},
           {"inliers", l.inliers},
