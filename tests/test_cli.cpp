@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <regex>
@@ -1638,6 +1639,25 @@ TEST(CliRealRig, AFrontCameraOnA360DegreeLidarMapsAndLocalizesWithANetworksLabel
           " --map " + map + " --out " + (tmp.path() / "loc").string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("frames 10  localizations 10"), std::string::npos) << r.out;
+  // Against the map without labels, the labels lose only what the config drops by class (the
+  // cars): kept, the class boundaries give at least as many map segments.
+  const auto map_segments = [&](const std::string& options) {
+    const Result m = run("map" + dataset + options + " --out " + map);
+    EXPECT_EQ(m.code, 0) << m.err;
+    const size_t at = m.out.find(")  map ");
+    return at == std::string::npos ? 0ul : std::stoul(m.out.substr(at + 7));
+  };
+  std::ifstream in("config/lidar-camera.yaml");
+  std::string keep((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t setting = keep.find("remove_dynamic_classes: true");
+  ASSERT_NE(setting, std::string::npos);
+  keep.replace(setting, 28, "remove_dynamic_classes: false");
+  std::ofstream((tmp.path() / "keep-dynamic.yaml").string()) << keep;  // finds its models by name
+  const size_t without_labels = map_segments(" --config config/lidar-camera.yaml");
+  EXPECT_GE(map_segments(" --labels " + labels + " --config " +
+                         (tmp.path() / "keep-dynamic.yaml").string()),
+            without_labels);
+  EXPECT_GT(without_labels, 40u);
 }
 
 }  // namespace
