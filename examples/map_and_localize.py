@@ -25,6 +25,7 @@ def main():
     parser.add_argument("--out", default="", help="save the target map there")
     args = parser.parse_args()
 
+    ssm.keep_freed_memory_for_torch()  # a program that describes many segments: its own choice
     config = ssm.load_config(args.config)
     mapping = ssm.open_dataset(args.map_dataset)
     describer = ssm.describer_for(config.descriptor, mapping.info)

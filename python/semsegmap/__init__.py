@@ -4,6 +4,7 @@ The C++ library's bindings (semsegmap._semsegmap, python/src/), with nothing of 
 names, fields and errors are the library's. Arrays are numpy arrays; long calls release the GIL.
 
     import semsegmap as ssm
+    ssm.keep_freed_memory_for_torch()  # once: faster learned descriptors (process-wide malloc)
     config = ssm.load_config(ssm.shipped_file("config/semsegmap.yaml"))
     mapping = ssm.open_dataset("sim:world=1,run=S1,preset=tiny")
     describer = ssm.describer_for(config.descriptor, mapping.info)

@@ -5,6 +5,9 @@
 
 #include "bindings.h"
 #include "semsegmap/describe/descriptor.h"
+#if SEMSEGMAP_WITH_TORCH
+#include "semsegmap/describe/learned_describer.h"
+#endif
 #include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/input_modalities.h"
 
@@ -64,6 +67,17 @@ void bindDescribe(py::module_& m) {
       "descriptor_not_built",
       [](const std::string& kind) { return descriptorNotBuilt(parseDescriptorKind(kind)); },
       py::arg("kind"), "Why this build cannot describe with `kind`, or '' when it can");
+  // Process-wide, so the program's choice (describe/learned_describer.h says why it pays).
+  m.def(
+      "keep_freed_memory_for_torch",
+      [] {
+#if SEMSEGMAP_WITH_TORCH
+        keepFreedMemoryForTorch();
+#endif
+      },
+      "Once at start-up of a program that describes many segments with a learned descriptor: "
+      "glibc's malloc keeps freed activations instead of faulting them back in (40-50 % of "
+      "their time). Process-wide, idempotent; a no-op without glibc or libtorch.");
 }
 
 }  // namespace semsegmap::python

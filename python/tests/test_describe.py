@@ -76,3 +76,11 @@ def test_what_this_build_lacks_is_said():
     if not ssm.WITH_TORCH:
         with pytest.raises(RuntimeError, match="SEMSEGMAP_WITH_TORCH"):
             ssm.make_describer(ssm.DescriptorConfig(kind="semsegmap-net", model="x.model"))
+
+
+def test_malloc_tuning_is_the_programs_call_and_keeps_descriptors_unchanged():
+    eigen = ssm.make_describer(ssm.DescriptorConfig(kind="eigen"))
+    before = eigen.describe([box()])
+    assert ssm.keep_freed_memory_for_torch() is None
+    ssm.keep_freed_memory_for_torch()  # idempotent
+    assert np.array_equal(eigen.describe([box()]), before)
