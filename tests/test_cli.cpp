@@ -1613,6 +1613,30 @@ TEST(Docs, ThePjlabEnrichExampleRunsAsShown) {
   EXPECT_EQ(byte(16) << 24 | byte(17) << 16 | byte(18) << 8 | byte(19), 720u);
 }
 
+// The README's PCD example as it reads, in a folder where `kitti00/` is the real first ten scans
+// of KITTI 00 with their poses.txt and calib.txt, and `config/` a copy of the shipped configs: it
+// prints what the README shows.
+TEST(Docs, TheReadmeKittiPcdExampleRunsAsShown) {
+  const std::filesystem::path sample =
+      std::filesystem::path(SEMSEGMAP_SHARED_DATA) / "kitti00_first10_pcd";
+  if (!std::filesystem::exists(sample)) GTEST_SKIP() << "the real KITTI 00 PCD scans are absent";
+  if (!SEMSEGMAP_WITH_PCL)
+    GTEST_SKIP() << "PCD files are read with PCL, which this build leaves out";
+  if (!SEMSEGMAP_WITH_TORCH) GTEST_SKIP() << "config/lidar-camera.yaml's descriptor needs libtorch";
+  TempDir tmp;
+  std::filesystem::create_directory_symlink(sample, tmp.path() / "kitti00");
+  std::filesystem::copy("config", tmp.path() / "config");
+  const std::vector<std::string> block =
+      test_support::blockContaining("README.md", "folder:kitti00");
+  ASSERT_EQ(block.size(), 2u) << "the command and the line it prints";
+  const Result r = run("--version > /dev/null && cd '" + tmp.path().string() + "' && '" +
+                       std::filesystem::absolute(g_binary).string() + "' " + block[0].substr(16));
+  ASSERT_EQ(r.code, 0) << r.err;
+  // What the README says it prints, up to the map's size in bytes (which holds the paths given).
+  const std::string shown = block[1].substr(2, block[1].find(" segments, ") + 9 - 2);
+  EXPECT_NE(r.out.find(shown), std::string::npos) << r.out << "\nthe README shows: " << shown;
+}
+
 TEST(CliRealRig, AFrontCameraOnA360DegreeLidarMapsAndLocalizesWithANetworksLabels) {
   const std::filesystem::path sample = std::filesystem::path(SEMSEGMAP_SHARED_DATA) /
                                        "kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
