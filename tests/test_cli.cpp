@@ -1585,6 +1585,14 @@ TEST(Docs, CheckUsageRefusesWhatTheCommandWouldAndRunsNothing) {
   EXPECT_FALSE(std::filesystem::exists(out)) << "nothing runs, nothing is written";
 }
 
+// A documented `build/semsegmap ...` line run as shown, from `dir` (this build's binary for
+// `build/semsegmap`; `--version` first, since run() names the binary itself).
+Result runDocumented(const std::filesystem::path& dir, const std::string& line) {
+  return run("--version > /dev/null && cd '" + dir.string() + "' && '" +
+             std::filesystem::absolute(g_binary).string() + "' " +
+             line.substr(std::string("build/semsegmap ").size()));
+}
+
 // docs/real-data.md's PJLab example run as the page shows it, in a folder where `pjlab/` is the
 // real sample and `examples/` the repository's: the overlay is written at the width asked.
 TEST(Docs, ThePjlabEnrichExampleRunsAsShown) {
@@ -1600,8 +1608,7 @@ TEST(Docs, ThePjlabEnrichExampleRunsAsShown) {
   size_t ran = 0;
   for (std::string line : test_support::blockContaining("docs/real-data.md", "folder:pjlab")) {
     if (line.rfind("build/semsegmap ", 0) != 0) continue;
-    const Result r = run("--version > /dev/null && cd '" + tmp.path().string() + "' && '" +
-                         std::filesystem::absolute(g_binary).string() + "' " + line.substr(16));
+    const Result r = runDocumented(tmp.path(), line);
     ASSERT_EQ(r.code, 0) << line << "\n" << r.err;
     ++ran;
   }
@@ -1629,8 +1636,7 @@ TEST(Docs, TheReadmeKittiPcdExampleRunsAsShown) {
   const std::vector<std::string> block =
       test_support::blockContaining("README.md", "folder:kitti00");
   ASSERT_EQ(block.size(), 2u) << "the command and the line it prints";
-  const Result r = run("--version > /dev/null && cd '" + tmp.path().string() + "' && '" +
-                       std::filesystem::absolute(g_binary).string() + "' " + block[0].substr(16));
+  const Result r = runDocumented(tmp.path(), block[0]);
   ASSERT_EQ(r.code, 0) << r.err;
   // What the README says it prints, up to the map's size in bytes (which holds the paths given).
   const std::string shown = block[1].substr(2, block[1].find(" segments, ") + 9 - 2);
