@@ -107,6 +107,18 @@ std::vector<bool> beyondPlane(const EnrichedCloud& cloud, Eigen::Vector3f n, dou
   return beyond;
 }
 
+// The point as a sensor without that modality gives it.
+void dropModalitiesOf(EnrichedPoint& p, bool drop_color, bool drop_classes) {
+  if (drop_color) {
+    p.h = p.s = p.v = 0;
+    p.has_color = false;
+  }
+  if (drop_classes) {
+    p.class_id = cls::kUnknown;
+    p.has_class = false;
+  }
+}
+
 // A plane of direction uniform on the sphere.
 std::vector<bool> beyondRandomPlane(const EnrichedCloud& cloud, double fraction,
                                     std::mt19937& rng) {
@@ -153,7 +165,7 @@ EnrichedCloud unobserveSection(const EnrichedCloud& cloud, double fraction, std:
   const std::vector<bool> beyond = beyondPlane(cloud, n, fraction);
   EnrichedCloud out = cloud;
   for (size_t i = 0; i < out.size(); ++i)
-    if (beyond[i]) out[i] = dropModalities({out[i]}, true, true).front();
+    if (beyond[i]) dropModalitiesOf(out[i], true, true);
   return out;
 }
 
@@ -191,16 +203,7 @@ EnrichedCloud relabelPoints(const EnrichedCloud& cloud, double fraction, int num
 
 EnrichedCloud dropModalities(const EnrichedCloud& cloud, bool drop_color, bool drop_classes) {
   EnrichedCloud out = cloud;
-  for (EnrichedPoint& p : out) {
-    if (drop_color) {
-      p.h = p.s = p.v = 0;
-      p.has_color = false;
-    }
-    if (drop_classes) {
-      p.class_id = cls::kUnknown;
-      p.has_class = false;
-    }
-  }
+  for (EnrichedPoint& p : out) dropModalitiesOf(p, drop_color, drop_classes);
   return out;
 }
 
