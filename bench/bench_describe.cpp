@@ -9,9 +9,9 @@
 #include <filesystem>
 #include <random>
 
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/describe/learned_net.h"
-#include "semsegmap/io/model_file.h"
 
 using namespace semsegmap;
 

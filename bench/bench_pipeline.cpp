@@ -7,13 +7,13 @@
 // at least 20 Hz on 2 cores without the network.
 #include <benchmark/benchmark.h>
 
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/describe/learned_describer.h"
-#include "semsegmap/io/class_map_file.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/semantics/frame_labeler.h"
+#include "semsegmap/settings/class_map_file.h"
+#include "semsegmap/settings/config.h"
 #include "semsegmap/sim/simulator.h"
 
 using namespace semsegmap;

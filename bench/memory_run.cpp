@@ -21,13 +21,13 @@
 #include <string>
 #include <vector>
 
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/describe/learned_describer.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/input_modalities.h"
 #include "semsegmap/pipeline/modes.h"
+#include "semsegmap/settings/config.h"
 #include "semsegmap/viz/plot.h"
 
 using namespace semsegmap;

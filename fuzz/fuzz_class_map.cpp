@@ -1,9 +1,9 @@
-// Class maps (io/class_map_file.h) against the project's class table, and the info file of a
+// Class maps (settings/class_map_file.h) against the project's class table, and the info file of a
 // label set (io/label_set.h), both YAML.
 #include "fuzz_input.h"
 #include "semsegmap/core/class_table.h"
-#include "semsegmap/io/class_map_file.h"
 #include "semsegmap/io/label_set.h"
+#include "semsegmap/settings/class_map_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace semsegmap;

@@ -1,6 +1,6 @@
-// Configuration YAML (io/config.h): the pipeline, odometry and semantics sections.
+// Configuration YAML (settings/config.h): the pipeline, odometry and semantics sections.
 #include "fuzz_input.h"
-#include "semsegmap/io/config.h"
+#include "semsegmap/settings/config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace semsegmap;

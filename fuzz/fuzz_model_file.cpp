@@ -1,7 +1,7 @@
-// Model files of the learned descriptors (io/model_file.h): read, then (with libtorch) the
+// Model files of the learned descriptors (artefacts/model_file.h): read, then (with libtorch) the
 // network built from them, as `descriptor.model` is loaded.
 #include "fuzz_input.h"
-#include "semsegmap/io/model_file.h"
+#include "semsegmap/artefacts/model_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace semsegmap;

@@ -1,7 +1,7 @@
-// The training cache (io/training_cache.h), with the provenance the seed generator writes; the
-// input is the file without its trailing checksum, which the harness appends.
+// The training cache (artefacts/training_cache.h), with the provenance the seed generator writes;
+// the input is the file without its trailing checksum, which the harness appends.
 #include "fuzz_input.h"
-#include "semsegmap/io/training_cache.h"
+#include "semsegmap/artefacts/training_cache.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace semsegmap;

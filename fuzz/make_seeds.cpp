@@ -7,14 +7,14 @@
 #include <iostream>
 #include <sstream>
 
+#include "semsegmap/artefacts/map_file.h"
+#include "semsegmap/artefacts/model_file.h"
+#include "semsegmap/artefacts/training_cache.h"
 #include "semsegmap/core/binary_io.h"
 #include "semsegmap/io/dataset_format.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/label_set.h"
-#include "semsegmap/io/map_file.h"
-#include "semsegmap/io/model_file.h"
 #include "semsegmap/io/ply_writer.h"
-#include "semsegmap/io/training_cache.h"
 #if SEMSEGMAP_WITH_TORCH
 #include "semsegmap/describe/learned_net.h"
 #endif

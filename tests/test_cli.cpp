@@ -1695,10 +1695,7 @@ TEST(CliRealRig, AFrontCameraOnA360DegreeLidarMapsAndLocalizesWithANetworksLabel
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: test_cli PATH_TO_SEMSEGMAP [gtest options]\n");
-    return 2;
-  }
-  semsegmap::g_binary = argv[1];
+  // The binary of this build, or another one given as the first argument.
+  semsegmap::g_binary = argc >= 2 ? argv[1] : SEMSEGMAP_BINARY;
   return RUN_ALL_TESTS();
 }

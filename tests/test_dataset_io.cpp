@@ -20,7 +20,7 @@
 #include "semsegmap/io/dataset_reader.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/io/image_io.h"
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/run_output.h"
 #include "temp_dir.h"
 
 namespace semsegmap {

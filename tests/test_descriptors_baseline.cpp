@@ -16,7 +16,7 @@
 #if SEMSEGMAP_WITH_PCL
 #include "semsegmap/describe/fpfh_descriptor.h"
 #endif
-#include "semsegmap/io/model_file.h"
+#include "semsegmap/artefacts/model_file.h"
 
 using namespace semsegmap;
 namespace ef = semsegmap::eigen_feature;

@@ -13,7 +13,7 @@
 #include "mini_kitti.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/eval/semantics_experiment.h"
-#include "semsegmap/io/config.h"
+#include "semsegmap/settings/config.h"
 #include "temp_dir.h"
 
 namespace semsegmap {

@@ -10,10 +10,10 @@
 #include <numeric>
 #include <set>
 
+#include "semsegmap/artefacts/model_file.h"
+#include "semsegmap/artefacts/training_cache.h"
 #include "semsegmap/datasets/dataset_specs.h"
 #include "semsegmap/datasets/open_dataset.h"
-#include "semsegmap/io/model_file.h"
-#include "semsegmap/io/training_cache.h"
 #include "semsegmap/learn/augment.h"
 #include "semsegmap/learn/trainer.h"
 #include "semsegmap/learn/training_data.h"

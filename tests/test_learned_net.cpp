@@ -14,13 +14,13 @@
 #include <set>
 #include <string>
 
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/binary_io.h"
 #include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/describe/learned_net.h"
 #include "semsegmap/describe/net_input.h"
 #include "semsegmap/describe/pointnet_ops.h"
 #include "semsegmap/describe/semsegmap_net.h"
-#include "semsegmap/io/model_file.h"
 
 using namespace semsegmap;
 
@@ -516,8 +516,8 @@ TEST(ModelFile, TensorShapesOfAConfigurationAreThoseOfItsNetwork) {
 
 namespace {
 
-// A model file's header (io/model_file.h, version 3) for `config`, then `tensor_count`, and no
-// tensors: what a corrupt or truncated file starts with.
+// A model file's header (artefacts/model_file.h, version 3) for `config`, then `tensor_count`, and
+// no tensors: what a corrupt or truncated file starts with.
 std::string modelHeader(const NetConfig& c, uint64_t tensor_count) {
   BinaryWriter w;
   w.putBytes("SSMNET", 6);

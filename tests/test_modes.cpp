@@ -13,19 +13,19 @@
 #include <random>
 
 #include "build_options.h"
+#include "semsegmap/artefacts/map_file.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/core/frame_subset.h"
 #include "semsegmap/datasets/lidar_odometry_source.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/graph/trajectory.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/map_file.h"
-#include "semsegmap/io/model_file.h"
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/pipeline/input_modalities.h"
 #include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/slam.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap {
 namespace {

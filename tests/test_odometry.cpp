@@ -13,10 +13,10 @@
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/eval/odometry_metrics.h"
 #include "semsegmap/eval/odometry_run.h"
-#include "semsegmap/io/config.h"
 #include "semsegmap/io/kitti_calib.h"
 #include "semsegmap/odometry/lidar_odometry.h"
 #include "semsegmap/odometry/motion.h"
+#include "semsegmap/settings/config.h"
 #if SEMSEGMAP_TEST_PCL
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>

@@ -3,8 +3,8 @@
 #include <algorithm>
 
 #include "semsegmap/core/diagnostics.h"
-#include "semsegmap/io/config.h"
 #include "semsegmap/pipeline/pipeline.h"
+#include "semsegmap/settings/config.h"
 #include "semsegmap/sim/simulator.h"
 
 using namespace semsegmap;

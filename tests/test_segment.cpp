@@ -9,8 +9,8 @@
 #include <random>
 #include <set>
 
-#include "semsegmap/io/config.h"
 #include "semsegmap/segment/incremental_segmenter.h"
+#include "semsegmap/settings/config.h"
 
 using namespace semsegmap;
 

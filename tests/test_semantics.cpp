@@ -8,11 +8,11 @@
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/semantic_sources.h"
-#include "semsegmap/io/class_map_file.h"
-#include "semsegmap/io/config.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/label_set.h"
 #include "semsegmap/semantics/frame_labeler.h"
+#include "semsegmap/settings/class_map_file.h"
+#include "semsegmap/settings/config.h"
 #include "temp_dir.h"
 
 namespace semsegmap {

@@ -8,9 +8,9 @@
 #include <limits>
 #include <random>
 
+#include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/binary_io.h"
-#include "semsegmap/io/map_file.h"
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/target_map.h"
 #include "semsegmap/pipeline/map_parameters.h"

@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "error_text.h"
+#include "semsegmap/artefacts/segments_io.h"
 #include "semsegmap/io/csv_table.h"
-#include "semsegmap/io/localization_details.h"
-#include "semsegmap/io/run_folders.h"
-#include "semsegmap/io/run_output.h"
-#include "semsegmap/io/segments_io.h"
 #include "semsegmap/io/trajectory_file.h"
+#include "semsegmap/outputs/localization_details.h"
+#include "semsegmap/outputs/run_folders.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/viz/scene_export.h"
 #include "temp_dir.h"
 

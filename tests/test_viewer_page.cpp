@@ -21,9 +21,9 @@
 #include <string>
 
 #include "command_result.h"
+#include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/io/csv_table.h"
-#include "semsegmap/io/map_file.h"
 #include "temp_dir.h"
 
 #ifndef SEMSEGMAP_TEST_VIEWER

@@ -10,10 +10,10 @@
 #include "cli_args.h"
 #include "progress.h"
 #include "resources.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/report.h"
-#include "semsegmap/io/model_file.h"
 #include "semsegmap/sim/simulator.h"
 #include "semsegmap/viz/sim_overview.h"
 #if SEMSEGMAP_WITH_VIEWER

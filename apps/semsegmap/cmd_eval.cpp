@@ -11,11 +11,11 @@
 #include "eval_args.h"
 #include "progress.h"
 #include "resources.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/eval/report.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/model_file.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 

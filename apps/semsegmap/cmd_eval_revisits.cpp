@@ -9,8 +9,8 @@
 #include "dataset_args.h"
 #include "eval_args.h"
 #include "progress.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/eval/revisit_experiment.h"
-#include "semsegmap/io/model_file.h"
 
 namespace semsegmap::app {
 

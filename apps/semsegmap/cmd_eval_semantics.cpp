@@ -11,7 +11,7 @@
 #include "progress.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/eval/semantics_experiment.h"
-#include "semsegmap/io/config.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 

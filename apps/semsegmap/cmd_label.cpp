@@ -9,9 +9,9 @@
 #include "dataset_args.h"
 #include "progress.h"
 #include "semsegmap/datasets/semantic_sources.h"
-#include "semsegmap/io/config.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/label_set.h"
+#include "semsegmap/settings/config.h"
 #include "semsegmap/viz/label_overlay.h"
 
 namespace semsegmap::app {

@@ -6,15 +6,15 @@
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "progress.h"
+#include "semsegmap/artefacts/map_file.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/localization_picture.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/localization_details.h"
-#include "semsegmap/io/map_file.h"
-#include "semsegmap/io/model_file.h"
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/localization_details.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/modes.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 

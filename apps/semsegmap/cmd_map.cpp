@@ -5,11 +5,11 @@
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "progress.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/map_file.h"
-#include "semsegmap/io/model_file.h"
+#include "semsegmap/artefacts/map_file.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/slam.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 

@@ -9,7 +9,7 @@
 #include "dataset_args.h"
 #include "progress.h"
 #include "semsegmap/eval/odometry_run.h"
-#include "semsegmap/io/config.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 

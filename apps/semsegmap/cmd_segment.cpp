@@ -6,9 +6,9 @@
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "progress.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/segments_io.h"
+#include "semsegmap/artefacts/segments_io.h"
 #include "semsegmap/pipeline/pipeline.h"
+#include "semsegmap/settings/config.h"
 #include "semsegmap/viz/segments_png.h"
 
 namespace semsegmap::app {

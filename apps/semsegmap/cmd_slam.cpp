@@ -7,12 +7,12 @@
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "progress.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/model_file.h"
-#include "semsegmap/io/run_output.h"
 #include "semsegmap/io/trajectory_file.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/pipeline/slam.h"
+#include "semsegmap/settings/config.h"
 #include "semsegmap/viz/trajectory_png.h"
 
 namespace semsegmap::app {

@@ -10,12 +10,12 @@
 
 #include "cli_args.h"
 #include "progress.h"
+#include "semsegmap/artefacts/model_file.h"
+#include "semsegmap/artefacts/training_cache.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/dataset_specs.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/model_file.h"
-#include "semsegmap/io/training_cache.h"
 #include "semsegmap/learn/trainer.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 

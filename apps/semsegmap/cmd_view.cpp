@@ -5,9 +5,9 @@
 #include <filesystem>
 
 #include "cli_args.h"
+#include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/diagnostics.h"
-#include "semsegmap/io/map_file.h"
 #include "semsegmap/viz/scene_export.h"
 #include "viewer_asset.h"
 

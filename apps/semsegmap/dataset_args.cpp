@@ -3,11 +3,11 @@
 #include <algorithm>
 
 #include "resources.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/datasets/open_dataset.h"
-#include "semsegmap/io/config.h"
-#include "semsegmap/io/model_file.h"
 #include "semsegmap/pipeline/input_modalities.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 

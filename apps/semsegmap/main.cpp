@@ -12,7 +12,7 @@
 #include "eval_args.h"
 #include "progress.h"
 #include "semsegmap/core/diagnostics.h"
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/run_output.h"
 #if SEMSEGMAP_WITH_TORCH
 #include "semsegmap/describe/learned_describer.h"
 #endif

@@ -131,7 +131,7 @@ class DatasetInfo:
     first_transient_instance: int
     def __init__(self, **fields: object) -> None: ...
 
-# configs: the C++ structs' fields (io/config.cpp maps the YAML keys onto them)
+# configs: the C++ structs' fields (settings/config.cpp maps the YAML keys onto them)
 
 class EnrichmentConfig:
     _fields: tuple[str, ...]
@@ -309,7 +309,7 @@ def keep_freed_memory_for_torch() -> None: ...
 def describer_for(config: DescriptorConfig, info: DatasetInfo, threads: int = 0) -> Describer: ...
 def descriptor_not_built(kind: str) -> str: ...
 
-# localize/ and io/map_file.h
+# localize/ and artefacts/map_file.h
 
 class MapSegment:
     _fields: tuple[str, ...]

@@ -1,9 +1,9 @@
 // The pipeline configuration (pipeline/pipeline_config.h and the stages' config structs) and its
-// YAML reader (io/config.h). Fields are named as in the C++ structs; io/config.cpp maps the YAML
-// keys onto them (e.g. localization.k is localization.localizer.index.k).
+// YAML reader (settings/config.h). Fields are named as in the C++ structs; settings/config.cpp maps
+// the YAML keys onto them (e.g. localization.k is localization.localizer.index.k).
 #include "bindings.h"
-#include "semsegmap/io/config.h"
 #include "semsegmap/pipeline/pipeline_config.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::python {
 

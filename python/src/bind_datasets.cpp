@@ -3,7 +3,7 @@
 #include "bindings.h"
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/datasets/open_dataset.h"
-#include "semsegmap/io/config.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::python {
 

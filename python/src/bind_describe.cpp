@@ -1,5 +1,5 @@
 // describe/: the four segment describers, made from a config as the command line makes them
-// (io/model_file.h makeDescriber; apps/semsegmap/dataset_args.cpp describerFor), describing
+// (artefacts/model_file.h makeDescriber; apps/semsegmap/dataset_args.cpp describerFor), describing
 // segment points given as numpy arrays.
 #include <iostream>
 
@@ -8,7 +8,7 @@
 #if SEMSEGMAP_WITH_TORCH
 #include "semsegmap/describe/learned_describer.h"
 #endif
-#include "semsegmap/io/model_file.h"
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/pipeline/input_modalities.h"
 
 namespace semsegmap::python {

@@ -1,10 +1,10 @@
-// localize/ and io/map_file.h: target maps built, saved, loaded and localized against. A target
-// map is immutable from Python (its arrays are read-only): localizers share it.
+// localize/ and artefacts/map_file.h: target maps built, saved, loaded and localized against. A
+// target map is immutable from Python (its arrays are read-only): localizers share it.
 #include <stdexcept>
 
 #include "bindings.h"
+#include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/describe/descriptor.h"
-#include "semsegmap/io/map_file.h"
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/target_map.h"
 #include "semsegmap/pipeline/map_parameters.h"

@@ -30,7 +30,7 @@ def test_the_shipped_config_is_read_with_its_model_beside_it():
 
 def test_fields_change_in_place_at_any_depth(tmp_dir):
     c = ssm.load_config(write(tmp_dir, "localization:\n  k: 5\n  min_inliers: 7\n"))
-    # YAML keys land on the C++ structs' fields (io/config.cpp).
+    # YAML keys land on the C++ structs' fields (settings/config.cpp).
     assert c.localization.localizer.index.k == 5
     assert c.localization.localizer.verification.min_inliers == 7
     c.localization.localizer.index.k = 9

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <semsegmap/io/map_file.h>
+#include <semsegmap/artefacts/map_file.h>
 #include <semsegmap/localize/localizer.h>
 
 int main(int argc, char** argv) {

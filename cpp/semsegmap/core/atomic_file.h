@@ -16,7 +16,7 @@ void writeFileAtomically(const std::filesystem::path& path,
 void writeBytesAtomically(const std::filesystem::path& path, const std::string& bytes);
 
 // Called with every file the writes above put in place where none was before, from any thread
-// (one at a time): io/run_output.h's RunOutputs records them, to remove the files of a command
+// (one at a time): outputs/run_output.h's RunOutputs records them, to remove the files of a command
 // that fails. An empty function (the default) turns it off.
 void setNewFileObserver(std::function<void(const std::filesystem::path&)> observer);
 

@@ -4,9 +4,9 @@
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/diagnostics.h"
-#include "semsegmap/io/class_map_file.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/label_set.h"
+#include "semsegmap/settings/class_map_file.h"
 
 namespace semsegmap {
 

@@ -1,5 +1,5 @@
 // A network and its plain Model value (describe/net_config.h), both ways, and its fingerprint.
-// The bytes of a model file are io/model_file.cpp's business.
+// The bytes of a model file are artefacts/model_file.cpp's business.
 #include <cstdio>
 #include <cstring>
 #include <sstream>

@@ -61,7 +61,7 @@ torch::Tensor tripletLoss(const torch::Tensor& anchor, const torch::Tensor& posi
                           const torch::Tensor& negative, const torch::Tensor& sigma,
                           double margin = 0.4);
 
-// The plain value of a trained network (io/model_file.h reads and writes it): modelOf copies
+// The plain value of a trained network (artefacts/model_file.h reads and writes it): modelOf copies
 // the weights out, netFromModel builds the network of model.config and copies them in, checking
 // every name and shape and the fingerprint (std::runtime_error saying what does not match).
 Model modelOf(DescriptorNetImpl& net);

@@ -1,5 +1,5 @@
 // What a learned descriptor network is, without torch: its configuration and, once trained, its
-// weights as plain values. Model files (io/model_file.h) store exactly this.
+// weights as plain values. Model files (artefacts/model_file.h) store exactly this.
 #pragma once
 
 #include <cstdint>

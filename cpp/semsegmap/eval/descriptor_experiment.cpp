@@ -4,8 +4,8 @@
 #include <memory>
 #include <sstream>
 
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/datasets/dataset_specs.h"
-#include "semsegmap/io/model_file.h"
 #include "semsegmap/viz/plot.h"
 
 namespace semsegmap {

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "semsegmap/io/config.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap {
 

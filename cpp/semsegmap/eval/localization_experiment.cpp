@@ -6,12 +6,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/localization_metrics.h"
-#include "semsegmap/io/model_file.h"
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/viz/plot.h"
 
 namespace semsegmap {

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 
+#include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/localization_picture.h"
-#include "semsegmap/io/localization_details.h"
-#include "semsegmap/io/map_file.h"
+#include "semsegmap/outputs/localization_details.h"
 
 namespace semsegmap {
 

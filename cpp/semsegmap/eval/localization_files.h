@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "semsegmap/eval/experiment.h"
-#include "semsegmap/io/run_output.h"
 #include "semsegmap/localize/target_map.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/pipeline/modes.h"
 
 namespace semsegmap {
@@ -41,7 +41,7 @@ std::vector<BuiltMap> finishMaps(std::vector<std::unique_ptr<MappingSession>>& s
 // configuration keeps (target_map.max_points_per_segment, 0: none), not the pictures'.
 BuiltMap saveBuiltMap(const std::filesystem::path& path, TargetMap built, size_t kept_points);
 
-// localizations.csv, matches.csv, trajectory.csv (io/localization_details.h), summary.json and
+// localizations.csv, matches.csv, trajectory.csv (outputs/localization_details.h), summary.json and
 // localization.png of one run in `dir`; the map's descriptor, size and bytes are filled into
 // `context`.
 void writeLocalizationRunFiles(const std::filesystem::path& dir, const LocalizationRun& run,

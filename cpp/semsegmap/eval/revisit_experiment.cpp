@@ -7,13 +7,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/frame_subset.h"
 #include "semsegmap/eval/ground_truth_check.h"
 #include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/localization_metrics.h"
-#include "semsegmap/io/model_file.h"
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/pipeline/input_modalities.h"
 #include "semsegmap/viz/plot.h"
 

@@ -1,5 +1,5 @@
-// Stamped poses and the absolute trajectory error between an estimate and ground truth (the
-// files: io/trajectory_file.h).
+// The absolute trajectory error between an estimate and ground truth (stamped poses:
+// core/stamped_pose.h; the files: io/trajectory_file.h).
 #pragma once
 
 #include <cstddef>
@@ -7,21 +7,9 @@
 #include <vector>
 
 #include "semsegmap/core/pose.h"
+#include "semsegmap/core/stamped_pose.h"
 
 namespace semsegmap {
-
-struct StampedPose {
-  double timestamp_s = 0.0;
-  Pose T = Pose::Identity();
-};
-
-// The poses of a stamped trajectory, without their timestamps.
-std::vector<Pose> posesOf(const std::vector<StampedPose>& trajectory);
-
-// The pose at time t, interpolated between the two stamped poses around it (sorted by time).
-// Nothing when t lies outside the trajectory, or when the poses around it are more than
-// max_gap_s apart (a gap in the recording is not bridged by a straight line).
-std::optional<Pose> poseAt(const std::vector<StampedPose>& trajectory, double t, double max_gap_s);
 
 struct TrajectoryError {
   double rmse_m = 0.0;  // translation errors, pairwise

@@ -10,7 +10,7 @@
 #include "semsegmap/core/frame.h"
 #include "semsegmap/core/image.h"
 #include "semsegmap/core/sensor_rig.h"
-#include "semsegmap/graph/trajectory.h"
+#include "semsegmap/core/stamped_pose.h"
 #include "semsegmap/io/ros_messages.h"
 
 namespace semsegmap::rosmsg {

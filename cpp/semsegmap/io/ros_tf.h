@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "semsegmap/core/pose.h"
-#include "semsegmap/graph/trajectory.h"
+#include "semsegmap/core/stamped_pose.h"
 #include "semsegmap/io/ros_messages.h"
 
 namespace semsegmap::rosmsg {

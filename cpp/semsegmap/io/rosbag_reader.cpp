@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "semsegmap/core/diagnostics.h"
+#include "semsegmap/core/stamped_pose.h"
 #include "semsegmap/core/time_association.h"
-#include "semsegmap/graph/trajectory.h"
 #include "semsegmap/io/ros_decode.h"
 #include "semsegmap/io/ros_tf.h"
 #include "semsegmap/io/rosbag_storage.h"

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "semsegmap/graph/trajectory.h"
+#include "semsegmap/core/stamped_pose.h"
 
 namespace semsegmap {
 

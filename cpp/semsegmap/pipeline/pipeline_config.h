@@ -1,5 +1,5 @@
 // The configuration of the whole pipeline: one struct per stage, each with its defaults next to
-// the code that uses it. io/config.h reads it from YAML.
+// the code that uses it. settings/config.h reads it from YAML.
 #pragma once
 
 #include <string>

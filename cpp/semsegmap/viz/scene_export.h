@@ -14,9 +14,9 @@
 
 #include "semsegmap/core/class_table.h"
 #include "semsegmap/core/json.h"
-#include "semsegmap/io/localization_details.h"
-#include "semsegmap/io/run_folders.h"
 #include "semsegmap/localize/target_map.h"
+#include "semsegmap/outputs/localization_details.h"
+#include "semsegmap/outputs/run_folders.h"
 
 namespace semsegmap::viz {
 

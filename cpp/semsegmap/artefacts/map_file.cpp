@@ -1,4 +1,4 @@
-#include "semsegmap/io/map_file.h"
+#include "semsegmap/artefacts/map_file.h"
 
 #include <cstring>
 #include <stdexcept>

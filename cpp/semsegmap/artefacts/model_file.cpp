@@ -1,4 +1,4 @@
-#include "semsegmap/io/model_file.h"
+#include "semsegmap/artefacts/model_file.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/run_output.h"
 
 #include <unistd.h>
 

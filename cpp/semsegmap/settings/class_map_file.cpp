@@ -1,4 +1,4 @@
-#include "semsegmap/io/class_map_file.h"
+#include "semsegmap/settings/class_map_file.h"
 
 #include "semsegmap/io/yaml_fields.h"
 

@@ -1,4 +1,4 @@
-#include "semsegmap/io/config.h"
+#include "semsegmap/settings/config.h"
 
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/core/sensor_rig.h"
@@ -402,7 +402,7 @@ PipelineConfig loadPipelineConfig(const std::filesystem::path& path) {
                {"neighbours_m", set(rf.neighbours_m)}});
   readSection(path, root, "target_map",
               {{"duplicate_distance_m", set(c.target_map.duplicate_distance_m)},
-               // The map file stores a segment's point count in 16 bits (io/map_file.cpp).
+               // The map file stores a segment's point count in 16 bits (artefacts/map_file.cpp).
                {"max_points_per_segment", count(c.target_map.max_points_per_segment, 0, 65535)},
                {"earlier_observations_apart_m", set(c.target_map.earlier_observations_apart_m)}});
   auto& lc = c.loop_closure;

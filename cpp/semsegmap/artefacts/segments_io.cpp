@@ -1,4 +1,4 @@
-#include "semsegmap/io/segments_io.h"
+#include "semsegmap/artefacts/segments_io.h"
 
 #include <cstring>
 #include <iomanip>

@@ -1,4 +1,4 @@
-#include "semsegmap/io/run_folders.h"
+#include "semsegmap/outputs/run_folders.h"
 
 #include <cstring>
 #include <fstream>

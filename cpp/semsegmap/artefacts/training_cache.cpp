@@ -4,7 +4,7 @@
 // str = u32 length + bytes; observation = u16 instance, u16 class, u16 source, i64 segment,
 //   u32 n_points, f32 purity, 3 x f32 centroid, u32 count, count x 6 f32, count x u16 class,
 //   count x u8 modalities (1: has colour, 2: has a class).
-#include "semsegmap/io/training_cache.h"
+#include "semsegmap/artefacts/training_cache.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "semsegmap/io/localization_details.h"
+#include "semsegmap/outputs/localization_details.h"
 
 #include <array>
 #include <cstdio>
@@ -7,7 +7,7 @@
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/io/csv_table.h"
-#include "semsegmap/io/run_output.h"
+#include "semsegmap/outputs/run_output.h"
 
 namespace semsegmap {
 

@@ -54,8 +54,8 @@ struct SegmentFolder {
 
 SegmentFolder readSegmentFolder(const std::filesystem::path& dir);
 
-// The binary PLY of io/segments_io.h (x y z float, red green blue uchar, class ushort, segment
-// int); throws "<path>: ..." for any other layout or a truncated file.
+// The binary PLY of artefacts/segments_io.h (x y z float, red green blue uchar, class ushort,
+// segment int); throws "<path>: ..." for any other layout or a truncated file.
 std::vector<SegmentPoint> readSegmentPointsPly(const std::filesystem::path& path);
 
 }  // namespace semsegmap
