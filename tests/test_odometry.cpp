@@ -348,7 +348,7 @@ TEST(OdometryConfig, IsReadFromItsSectionAndTyposFail) {
   const auto dir = std::filesystem::temp_directory_path() / "semsegmap_odometry_config";
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "good.yaml") << "odometry:\n  voxel_size_m: 0.5\n  deskew: false\n"
-                                   << "  metric: point_to_point\n";
+                                   << "  icp:\n    metric: point_to_point\n";
   const OdometryConfig c = loadOdometryConfig(dir / "good.yaml");
   EXPECT_EQ(c.voxel_size_m, 0.5);
   EXPECT_FALSE(c.deskew);
@@ -356,7 +356,7 @@ TEST(OdometryConfig, IsReadFromItsSectionAndTyposFail) {
   EXPECT_EQ(c.max_range_m, OdometryConfig{}.max_range_m);  // untouched keys keep the default
   std::ofstream(dir / "typo.yaml") << "odometry:\n  voxel_size: 0.5\n";
   EXPECT_THROW(loadPipelineConfig(dir / "typo.yaml"), std::runtime_error);
-  std::ofstream(dir / "bad.yaml") << "odometry:\n  metric: point_to_line\n";
+  std::ofstream(dir / "bad.yaml") << "odometry:\n  icp:\n    metric: point_to_line\n";
   EXPECT_THROW(loadOdometryConfig(dir / "bad.yaml"), std::runtime_error);
   std::filesystem::remove_all(dir);
 }

@@ -250,7 +250,9 @@ TEST(PipelineConfig, UnknownKeysAndBadValuesNameTheFile) {
   expectError("segmentation:\n  d_segment_m: fast\n", "segmentation.d_segment_m");
   expectError("segmentation:\n  d_segment_m: -1\n", "d_segment_m");
   expectError("local_map: [1, 2]\n", "local_map");
-  expectError("refinement:\n  neighbours_m: -3\n", "refinement.neighbours_m");
+  expectError("localization:\n  refinement:\n    neighbours_m: -3\n",
+              "localization.refinement.neighbours_m");
+  expectError("refinement:\n  neighbours_m: -3\n", "refinement.neighbours_m");  // an old key
   expectError("localization:\n  latest_scan_fallback_m: -5\n",
               "localization.latest_scan_fallback_m");
   std::filesystem::remove(path);
@@ -258,7 +260,7 @@ TEST(PipelineConfig, UnknownKeysAndBadValuesNameTheFile) {
 }
 
 // issue 18: a directory given as config said "basic_filebuf::underflow", `localization.k:
-// 1000000000` "std::bad_alloc" and a value of the wrong type yaml-cpp's "bad conversion". Each now
+// 1000000000` (now localization.localizer.index.k) "std::bad_alloc" and a value of the wrong type yaml-cpp's "bad conversion". Each now
 // names the file, the key and the value, and every count has limits.
 TEST(PipelineConfig, CountsValuesAndDirectoriesNameTheFileAndTheKey) {
   const auto dir = std::filesystem::temp_directory_path() /
@@ -279,8 +281,10 @@ TEST(PipelineConfig, CountsValuesAndDirectoriesNameTheFileAndTheKey) {
     std::ofstream(path) << yaml;
     EXPECT_EQ(errorOf(path), path.string() + ": " + what) << yaml;
   };
-  expectError("localization:\n  k: 1000000000\n",
-              "localization.k: wrong type: expected an integer in [1, 1000], got '1000000000'");
+  expectError("localization:\n  localizer:\n    index:\n      k: 1000000000\n",
+              "localization.localizer.index.k: wrong type: expected an integer in [1, 1000], got "
+              "'1000000000'");
+  // An old key is named as the file has it.
   expectError("localization:\n  k: 2.5\n",
               "localization.k: wrong type: expected an integer in [1, 1000], got '2.5'");
   expectError("segmentation:\n  d_segment_m: .inf\n",
@@ -291,8 +295,9 @@ TEST(PipelineConfig, CountsValuesAndDirectoriesNameTheFileAndTheKey) {
               "local_map.remove_unknown_class: wrong type: expected true or false, got 'maybe'");
   expectError("semantics:\n  mean: [0.5, nan, 0.5]\n",
               "semantics.mean: wrong type: expected a list of finite numbers, got a list");
-  expectError("odometry:\n  max_iterations: -5\n",
-              "odometry.max_iterations: wrong type: expected an integer in [1, 10000], got '-5'");
+  expectError("odometry:\n  icp:\n    max_iterations: -5\n",
+              "odometry.icp.max_iterations: wrong type: expected an integer in [1, 10000], got "
+              "'-5'");
   expectError("? [a, b]\n: 1\n", "the top level: a key that is a list");
   std::filesystem::remove_all(dir);
 }

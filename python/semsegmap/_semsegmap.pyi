@@ -1,7 +1,7 @@
 # Type stubs of the bindings (python/src/), written by hand: python/tests/test_stubs.py checks
 # that they name exactly what the module has.
 from os import PathLike
-from typing import Dict, Iterator, Optional, Union
+from typing import Dict, Iterator, List, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -131,7 +131,8 @@ class DatasetInfo:
     first_transient_instance: int
     def __init__(self, **fields: object) -> None: ...
 
-# configs: the C++ structs' fields (settings/config.cpp maps the YAML keys onto them)
+# configs: the C++ structs' fields, whose attribute paths are the YAML keys
+# (pipeline/setting_table.h)
 
 class EnrichmentConfig:
     _fields: tuple[str, ...]
@@ -273,6 +274,7 @@ class PipelineConfig:
     def __init__(self, **fields: object) -> None: ...
 
 def load_config(path: _Path) -> PipelineConfig: ...
+def setting_table() -> List[Dict[str, object]]: ...
 
 # datasets/
 

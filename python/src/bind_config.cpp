@@ -1,9 +1,11 @@
 // The pipeline configuration (pipeline/pipeline_config.h and the stages' config structs) and its
-// YAML reader (settings/config.h). Fields are named as in the C++ structs; settings/config.cpp maps
-// the YAML keys onto them (e.g. localization.k is localization.localizer.index.k).
+// YAML reader (settings/config.h). Fields are named as in the C++ structs, and a setting's YAML key is
+// its attribute path (pipeline/setting_table.h; python/tests/test_config.py holds the fields
+// bound here to the table: localization.localizer.index.k is c.localization.localizer.index.k).
 #include "bindings.h"
-#include "semsegmap/pipeline/pipeline_config.h"
 #include "semsegmap/settings/config.h"
+#include "semsegmap/pipeline/pipeline_config.h"
+#include "semsegmap/pipeline/setting_table.h"
 
 namespace semsegmap::python {
 
@@ -105,6 +107,41 @@ void bindLocalizationConfigs(py::module_& m) {
       .field("graph", &LoopClosureConfig::graph);
 }
 
+const char* kindName(SettingKind kind) {
+  switch (kind) {
+    case SettingKind::kFlag:
+      return "flag";
+    case SettingKind::kCount:
+      return "count";
+    case SettingKind::kNumber:
+      return "number";
+    case SettingKind::kText:
+      return "text";
+    case SettingKind::kChoice:
+      return "choice";
+    case SettingKind::kTriple:
+      return "triple";
+  }
+  return "";
+}
+
+// The setting table as dicts, for a program that lists or checks settings.
+py::list settingTableList() {
+  py::list out;
+  for (const Setting& s : settingTable()) {
+    py::dict d;
+    d["key"] = s.key;
+    d["kind"] = kindName(s.kind);
+    if (s.kind == SettingKind::kCount) d["limits"] = py::make_tuple(s.lo, s.hi);
+    if (s.kind == SettingKind::kChoice) d["choices"] = s.choices;
+    d["recorded"] = s.recorded;
+    d["default"] = settingText(s.get(Settings{}));
+    d["description"] = s.description;
+    out.append(d);
+  }
+  return out;
+}
+
 }  // namespace
 
 void bindConfig(py::module_& m) {
@@ -124,6 +161,10 @@ void bindConfig(py::module_& m) {
       "Reads a YAML config (config/*.yaml) as the command line does: descriptor.model relative "
       "to the file; an unknown key, a wrong type or a bad value raises RuntimeError "
       "'<file>: <section.key>: <what>'.");
+  m.def("setting_table", &settingTableList,
+        "Every setting of a config file: key (its YAML key and attribute path; odometry.* and "
+        "semantics.* are read by the datasets), kind, limits or choices, whether a map records "
+        "it, its default as text and a description.");
 }
 
 }  // namespace semsegmap::python

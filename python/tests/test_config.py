@@ -29,8 +29,9 @@ def test_the_shipped_config_is_read_with_its_model_beside_it():
 
 
 def test_fields_change_in_place_at_any_depth(tmp_dir):
-    c = ssm.load_config(write(tmp_dir, "localization:\n  k: 5\n  min_inliers: 7\n"))
-    # YAML keys land on the C++ structs' fields (settings/config.cpp).
+    c = ssm.load_config(write(tmp_dir, "localization:\n  localizer:\n    index:\n      k: 5\n"
+                                       "    verification:\n      min_inliers: 7\n"))
+    # A YAML key is the attribute path of its field (pipeline/setting_table.h).
     assert c.localization.localizer.index.k == 5
     assert c.localization.localizer.verification.min_inliers == 7
     c.localization.localizer.index.k = 9
@@ -89,3 +90,60 @@ def test_a_missing_config_names_the_file(tmp_dir):
     path = os.path.join(tmp_dir, "none.yaml")
     with pytest.raises(RuntimeError, match=f"^{path}: no such config file$"):
         ssm.load_config(path)
+
+
+# The datasets read these sections; the Python module binds no config of theirs.
+UNBOUND_SECTIONS = ("odometry", "semantics")
+
+
+def bound_setting_keys():
+    return {s["key"] for s in ssm.setting_table()
+            if s["key"].split(".")[0] not in UNBOUND_SECTIONS}
+
+
+def attribute_paths(obj, prefix=""):
+    """The paths of the plain attributes under a config, through its nested configs."""
+    for name in obj._fields:
+        value = getattr(obj, name)
+        if hasattr(value, "_fields"):
+            yield from attribute_paths(value, prefix + name + ".")
+        else:
+            yield prefix + name
+
+
+def test_every_setting_is_an_attribute_path_and_every_attribute_a_setting():
+    c = ssm.PipelineConfig()
+    for key in bound_setting_keys():
+        obj = c
+        for name in key.split("."):
+            obj = getattr(obj, name)  # an AttributeError names the key that is no path
+    assert set(attribute_paths(c)) == bound_setting_keys()
+
+
+def test_the_stubs_declare_the_settings_as_attribute_paths():
+    import ast
+    with open(os.path.join(os.path.dirname(ssm.__file__), "_semsegmap.pyi")) as f:
+        tree = ast.parse(f.read())
+    classes = {node.name: {item.target.id: ast.unparse(item.annotation) for item in node.body
+                           if isinstance(item, ast.AnnAssign) and not item.target.id.startswith("_")}
+               for node in tree.body if isinstance(node, ast.ClassDef)}
+
+    def paths(cls, prefix=""):
+        for name, annotation in classes[cls].items():
+            if annotation.endswith("Config"):
+                yield from paths(annotation, prefix + name + ".")
+            else:
+                yield prefix + name
+
+    assert set(paths("PipelineConfig")) == bound_setting_keys()
+
+
+def test_the_setting_table_says_what_each_setting_is():
+    table = {s["key"]: s for s in ssm.setting_table()}
+    k = table["localization.localizer.index.k"]
+    assert k["kind"] == "count" and k["limits"] == (1, 1000) and k["default"] == "16"
+    assert not k["recorded"] and k["description"]
+    assert table["local_map.voxel_size_m"]["recorded"]
+    assert table["local_map.dynamic_removal"]["choices"] == ["point", "voxel"]
+    recorded = [key for key, s in table.items() if s["recorded"]]
+    assert recorded == list(ssm.map_parameters(ssm.PipelineConfig()))

@@ -1,6 +1,7 @@
 // The settings of a configuration that a target map's segments depend on, recorded in the map
 // (artefacts/map_file.h) and compared before localizing against it: enrichment, local map and
-// segmentation, by their YAML keys. The descriptor's kind, dimension and model are in the map's
+// segmentation: the settings the setting table marks recorded (pipeline/setting_table.h), by
+// their keys. The descriptor's kind, dimension and model are in the map's
 // header already (checkMapCompatible); batch sizes and picture points change no segment.
 #pragma once
 
@@ -11,8 +12,9 @@ namespace semsegmap {
 
 MapParameters mapParametersOf(const PipelineConfig& config);
 
-// A map's recorded settings as this build records them: keys that older builds did not write
-// are added with the value that their rules implied. Applied before every comparison.
+// A map's recorded settings as this build records them: old keys by their names now (the setting
+// table's aliases), keys that older builds did not write added with the value that their rules
+// implied. Applied before every comparison.
 MapParameters upgradeMapParameters(MapParameters recorded);
 
 // What a difference between a map's recorded settings and the configuration's does: refuse (a
