@@ -7,6 +7,7 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/eval/odometry_run.h"
 #include "semsegmap/io/config.h"
@@ -21,9 +22,12 @@ int runOdometryCommand(const CliArgs& a) {
   const std::filesystem::path out = a.get("out");
   auto source = openDatasetArg(a);
   Progress progress("odometry", 0);
-  const OdometryRun run =
-      runLidarOdometry(*source, config, a.frameLimit(),
-                       [&](size_t done, size_t total) { progress.update(done, total); });
+  const OdometryRun run = runLidarOdometry(
+      *source, config, a.frameLimit(),
+      [&](size_t done, size_t total) { progress.update(done, total); }, stopToken());
+  const size_t total = framesToRead(*source, a.frameLimit());
+  // Stopped before its first frame: nothing worth writing (main removes what the run made).
+  if (run.interrupted && run.frames.empty()) return interruptedRun("odometry", 0, total, "");
   writeOdometryFiles(out, run);
   const std::optional<OdometryErrors> errors = odometryErrors(run);
   size_t predicted = 0;
@@ -43,6 +47,7 @@ int runOdometryCommand(const CliArgs& a) {
     std::printf("no ground truth: errors unknown\n");
   std::cout << "wrote " << (out / "trajectory_tum.txt").string()
             << ", trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << "\n";
+  if (run.interrupted) return interruptedRun("odometry", run.frames.size(), total, out.string());
   return 0;
 }
 
@@ -60,7 +65,9 @@ const CommandSpec& odometryCommand() {
                          maxFramesOption(),
                      },
                      /*odometry_option=*/false, /*labels_option=*/false),
-      kDatasetNotes, runOdometryCommand};
+      kDatasetNotes,
+      runOdometryCommand,
+      /*stops_between_frames=*/true};
   return command;
 }
 

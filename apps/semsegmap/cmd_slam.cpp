@@ -6,6 +6,7 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/io/config.h"
@@ -30,7 +31,11 @@ int runSlamCommand(const CliArgs& a) {
   RunOptions options;
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
+  options.stop = stopToken();
   const SlamRun run = runSlam(*source, config, describer, options);
+  // Stopped before its first frame: nothing worth writing (main removes what the run made).
+  if (run.stats.interrupted && run.stats.frames == 0)
+    return interruptedRun("slam", 0, options.frameCount(*source), out.string());
 
   writeTum(out / "trajectory_tum.txt", run.trajectory);
   writeKitti(out / "trajectory_kitti.txt", run.trajectory);
@@ -67,6 +72,8 @@ int runSlamCommand(const CliArgs& a) {
               run.loops.size(), run.map.size(), run.stats.fps());
   std::cout << "wrote " << (out / "trajectory_tum.txt").string()
             << ", trajectory_kitti.txt, odometry_tum.txt, loops.csv, summary.json, slam.png\n";
+  if (run.stats.interrupted)
+    return interruptedRun("slam", run.stats.frames, options.frameCount(*source), out.string());
   return 0;
 }
 
@@ -74,7 +81,8 @@ int runSlamCommand(const CliArgs& a) {
 
 const CommandSpec& slamCommand() {
   static const CommandSpec command{
-      "slam", "mapping with loop closure on odometry -> trajectories, loops.csv, slam.png",
+      "slam",
+      "mapping with loop closure on odometry -> trajectories, loops.csv, slam.png",
       datasetOptions("the run to map",
                      {
                          {"config", Value::kText, "FILE", "",
@@ -82,7 +90,9 @@ const CommandSpec& slamCommand() {
                          {"out", Value::kText, "DIR", "", "output folder", kRequired},
                          maxFramesOption(),
                      }),
-      kDatasetNotes, runSlamCommand};
+      kDatasetNotes,
+      runSlamCommand,
+      /*stops_between_frames=*/true};
   return command;
 }
 

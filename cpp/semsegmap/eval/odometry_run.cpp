@@ -11,7 +11,8 @@
 namespace semsegmap {
 
 OdometryRun runLidarOdometry(FrameSource& source, const OdometryConfig& config, size_t max_frames,
-                             const std::function<void(size_t, size_t)>& progress) {
+                             const std::function<void(size_t, size_t)>& progress,
+                             const StopToken& stop) {
   OdometryRun run;
   run.dataset = source.info().name;
   const Pose T_base_lidar = source.info().rig.T_base_lidar;
@@ -19,6 +20,10 @@ OdometryRun runLidarOdometry(FrameSource& source, const OdometryConfig& config, 
   const size_t n = framesToRead(source, max_frames);
   bool all_ground_truth = true;
   for (size_t i = 0; i < n; ++i) {
+    if (stop.stopRequested()) {
+      run.interrupted = true;
+      break;
+    }
     const Frame f = source.frame(i);
     const auto start = std::chrono::steady_clock::now();
     const OdometryResult r = odometry.registerFrame(f.points, f.point_times, f.timestamp_s);
@@ -73,6 +78,7 @@ nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<Odomet
   nlohmann::ordered_json j;
   j["dataset"] = run.dataset;
   j["frames"] = run.frames.size();
+  j["interrupted"] = run.interrupted;  // `frames` are those done before Ctrl-C
   j["seconds"] = run.seconds;
   j["ms_per_frame"] = run.frames.empty()
                           ? nlohmann::ordered_json(nullptr)

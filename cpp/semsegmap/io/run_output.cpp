@@ -85,6 +85,8 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   j["config"] = c.config;
   j["descriptor"] = c.descriptor;
   j["frames"] = run.stats.frames;
+  // Ctrl-C ended the run early: `frames` are those done, every file of them whole.
+  j["interrupted"] = run.stats.interrupted;
   j["distance_m"] = run.distance_m;
   j["has_ground_truth"] = !run.trajectory_gt.empty();
   // The errors below measured against the very poses the local map was built on.
@@ -132,6 +134,7 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
   nlohmann::ordered_json j;
   j["dataset"] = dataset;
   j["frames"] = run.stats.frames;
+  j["interrupted"] = run.stats.interrupted;  // `frames` are those done before Ctrl-C
   j["loop_closures"] = run.loops.size();
   j["map_segments"] = run.map.size();
   j["fps"] = run.stats.fps();

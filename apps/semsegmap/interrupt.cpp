@@ -1,0 +1,64 @@
+#include "interrupt.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <iostream>
+
+#include "progress.h"
+
+namespace semsegmap::app {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+bool g_keep_outputs = false;
+
+// Async-signal-safe only: an atomic store, write(2) and _exit(2).
+extern "C" void onInterrupt(int) {
+  if (g_stop.exchange(true)) {
+    static const char kNow[] = "\nsemsegmap: interrupted again: exiting at once\n";
+    const ssize_t ignored = ::write(STDERR_FILENO, kNow, sizeof kNow - 1);
+    (void)ignored;
+    ::_exit(kExitInterrupted);
+  }
+}
+
+}  // namespace
+
+void installInterruptHandler() {
+  struct sigaction action {};
+  action.sa_handler = onInterrupt;
+  sigemptyset(&action.sa_mask);
+  // Reads of the data restart instead of failing with EINTR: the frame in hand finishes.
+  action.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+StopToken stopToken() {
+  return StopToken(g_stop);
+}
+
+bool stopRequested() {
+  return g_stop.load(std::memory_order_relaxed);
+}
+
+int interruptedRun(const std::string& command, size_t done, size_t total,
+                   const std::string& written) {
+  endProgressLine();
+  g_keep_outputs = done > 0;
+  std::cerr << "semsegmap " << command << ": interrupted after " << done << " of " << total
+            << " frames; "
+            << (done > 0 ? written + " holds the " + std::to_string(done) + " frames done"
+                         : std::string("nothing written"))
+            << "\n";
+  return kExitInterrupted;
+}
+
+bool interruptedRunKeepsOutputs() {
+  return g_keep_outputs;
+}
+
+}  // namespace semsegmap::app
