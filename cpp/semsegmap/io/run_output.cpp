@@ -206,16 +206,18 @@ fs::path shownParent(const fs::path& shown, const fs::path& full) {
 
 }  // namespace
 
-RunOutputs::RunOutputs() {
-  setNewFileObserver([this](const fs::path& path) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    written_.push_back(normalized(path));
-  });
-}
+RunOutputs::RunOutputs() = default;
 
 RunOutputs::~RunOutputs() {
-  setNewFileObserver({});
+  watches_.clear();  // first: no write reports to this object once it is being torn down
   if (!committed_) removeCreated();
+}
+
+void RunOutputs::watch(const fs::path& scope) {
+  watches_.push_back(std::make_unique<NewFileWatch>(scope, [this](const fs::path& path) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    written_.push_back(normalized(path));
+  }));
 }
 
 // The folder an output goes into must be there: a mistyped path (`--out /nonexistent/dir/x`)
@@ -246,10 +248,12 @@ size_t RunOutputs::folder(const fs::path& dir, const std::string& what) {
     fs::create_directory(full, ec);
     if (ec) refuse(dir, what, "cannot be created: " + ec.message());
     created_.push_back(full);
+    watch(full);  // claims its files from a RunOutputs whose folder holds it
     return 0;
   }
   requireWritableDirectory(full, dir, what);
   existing_.push_back(full);
+  watch(full);
   size_t listed = 0, entries = 0;
   for (auto it = fs::recursive_directory_iterator(full, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
@@ -270,6 +274,7 @@ bool RunOutputs::file(const fs::path& file, const std::string& what) {
   requireParent(full, file, what);
   if (fs::exists(full, ec)) return true;
   files_.push_back(full);
+  watch(full);
   return false;
 }
 
