@@ -950,6 +950,44 @@ TEST(CliPoseFiles, WithoutGroundTruthOrTimesNothingIsMadeUp) {
   EXPECT_EQ(second[2], "");
 }
 
+// slam and odometry on data without frame times write no TUM file (its times would be made up
+// from the rate): the KITTI files carry the poses, a note says so, and `semsegmap view` reads
+// them.
+TEST(CliPoseFiles, WithoutFrameTimesNoTumFileIsWritten) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path data = copyOfDataset(tmp.path() / "data"), dir = tmp.path();
+  std::ofstream(dir / "odom.txt") << poseFilesOf(data, "odom_").kitti;
+  const std::string scans = " --dataset folder:" + (data / "lidar").string();
+  const Result slam =
+      run("slam" + scans + " --odometry " + (dir / "odom.txt").string() + " --config " +
+          eigenConfig(dir, "eigen.yaml") + " --out " + (dir / "slam").string());
+  ASSERT_EQ(slam.code, 0) << slam.err;
+  EXPECT_NE(slam.err.find("no trajectory_tum.txt or odometry_tum.txt"), std::string::npos)
+      << slam.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "slam" / "trajectory_tum.txt"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "slam" / "odometry_tum.txt"));
+  EXPECT_EQ(lines(readFile(dir / "slam" / "trajectory_kitti.txt")), 3u);
+  EXPECT_EQ(lines(readFile(dir / "slam" / "odometry_kitti.txt")), 3u);
+  EXPECT_NE(readFile(dir / "slam" / "summary.json").find("\"has_frame_times\": false"),
+            std::string::npos);
+
+  const Result odometry = run("odometry" + scans + " --out " + (dir / "odo").string());
+  ASSERT_EQ(odometry.code, 0) << odometry.err;
+  EXPECT_NE(odometry.err.find("no trajectory_tum.txt"), std::string::npos) << odometry.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "odo" / "trajectory_tum.txt"));
+  EXPECT_EQ(lines(readFile(dir / "odo" / "trajectory_kitti.txt")), 3u);
+  EXPECT_NE(readFile(dir / "odo" / "summary.json").find("\"has_frame_times\": false"),
+            std::string::npos);
+
+  // With the data's times (the simulator's) the TUM files are there.
+  const Result timed =
+      run("odometry --dataset " + data.string() + " --out " + (dir / "timed").string());
+  ASSERT_EQ(timed.code, 0) << timed.err;
+  EXPECT_EQ(lines(readFile(dir / "timed" / "trajectory_tum.txt")), 3u);
+  EXPECT_EQ(timed.err.find("no trajectory_tum.txt"), std::string::npos) << timed.err;
+}
+
 // Runs `semsegmap ARGS` with stderr into a pipe and stdout to /dev/null; once stderr shows
 // `progress`, sends `signals` SIGINTs to it, as a user pressing Ctrl-C. Returns the exit code
 // and all of stderr.

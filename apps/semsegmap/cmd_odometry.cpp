@@ -1,6 +1,6 @@
 // semsegmap odometry: LiDAR odometry over a dataset, from its scans alone; writes the trajectory
-// (TUM and KITTI formats), summary.json and, with ground truth, the KITTI relative error, the ATE
-// and trajectory.png.
+// (TUM and KITTI formats; KITTI alone when the data has no frame times), summary.json and, with
+// ground truth, the KITTI relative error, the ATE and trajectory.png.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -9,6 +9,7 @@
 #include "dataset_args.h"
 #include "interrupt.h"
 #include "progress.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/eval/odometry_run.h"
 #include "semsegmap/io/config.h"
 
@@ -45,8 +46,15 @@ int runOdometryCommand(const CliArgs& a) {
         errors->kitti.segments.size(), errors->ate.rmse_m, errors->ate_aligned.rmse_m);
   else
     std::printf("no ground truth: errors unknown\n");
-  std::cout << "wrote " << (out / "trajectory_tum.txt").string()
-            << ", trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << "\n";
+  // A TUM file needs the data's times: without them one made up from the rate would pair the
+  // poses with the wrong data, so only the KITTI file is written (odometry_run.h).
+  if (!run.has_frame_times)
+    note(
+        "the data has no frame times: no trajectory_tum.txt (its times would be made up); "
+        "trajectory_kitti.txt holds the poses, line i for frame i of the run");
+  std::cout << "wrote " << (run.has_frame_times ? "trajectory_tum.txt, " : "")
+            << "trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << " to "
+            << out.string() << "\n";
   if (run.interrupted) return interruptedRun("odometry", run.frames.size(), total, out.string());
   return 0;
 }

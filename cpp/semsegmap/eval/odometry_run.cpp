@@ -15,6 +15,7 @@ OdometryRun runLidarOdometry(FrameSource& source, const OdometryConfig& config, 
                              const StopToken& stop) {
   OdometryRun run;
   run.dataset = source.info().name;
+  run.has_frame_times = source.info().has_frame_times;
   const Pose T_base_lidar = source.info().rig.T_base_lidar;
   LidarOdometry odometry(config);
   const size_t n = framesToRead(source, max_frames);
@@ -87,6 +88,8 @@ nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<Odomet
   // Without ground truth the errors are unknown: null, as in every summary.
   using Json = nlohmann::ordered_json;
   j["has_ground_truth"] = errors.has_value();
+  // false: no trajectory_tum.txt, its times would be made up (trajectory_kitti.txt has the poses).
+  j["has_frame_times"] = run.has_frame_times;
   j["kitti_relative_error"] = errors ? toJson(errors->kitti) : Json(nullptr);
   j["ate"] = errors ? toJson(errors->ate) : Json(nullptr);
   j["ate_aligned"] = errors ? toJson(errors->ate_aligned) : Json(nullptr);
@@ -95,7 +98,7 @@ nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<Odomet
 
 void writeOdometryFiles(const std::filesystem::path& out, const OdometryRun& run) {
   std::filesystem::create_directories(out);
-  writeTum(out / "trajectory_tum.txt", run.trajectory);
+  if (run.has_frame_times) writeTum(out / "trajectory_tum.txt", run.trajectory);
   writeKitti(out / "trajectory_kitti.txt", run.trajectory);
   const std::optional<OdometryErrors> errors = odometryErrors(run);
   writeJsonAtomically(out / "summary.json", toJson(run, errors));

@@ -26,6 +26,9 @@ struct OdometryRun {
   std::vector<Pose> ground_truth;       // T_world_base per frame, when every frame has it
   double seconds = 0.0;                 // in registerFrame only (not reading the data)
   bool interrupted = false;             // the stop request ended it early: `frames` are those done
+  // The trajectory's times are the data's; false: made up from the rate
+  // (DatasetInfo::has_frame_times), and writeOdometryFiles writes no TUM file.
+  bool has_frame_times = true;
 };
 
 // Registers the first max_frames frames (0: all) of `source`; progress(done, total) after each.
@@ -45,7 +48,8 @@ std::optional<OdometryErrors> odometryErrors(const OdometryRun& run);
 
 nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<OdometryErrors>& errors);
 
-// trajectory_tum.txt, trajectory_kitti.txt, summary.json and, with ground truth, trajectory.png
+// trajectory_tum.txt (only with the data's frame times: a made-up time would pair poses with the
+// wrong data), trajectory_kitti.txt, summary.json and, with ground truth, trajectory.png
 // (estimate against ground truth, from above) in `out`.
 void writeOdometryFiles(const std::filesystem::path& out, const OdometryRun& run);
 

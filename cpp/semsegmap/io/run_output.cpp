@@ -150,7 +150,7 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
   j["ate_slam_aligned"] = ate(&SlamErrors::slam_aligned);
   j["has_ground_truth"] = errors.has_value();
   j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
-  // false: the TUM files' times are made up from the rate, not the data's.
+  // false: the data has no frame times, so no TUM file was written (KITTI files alone).
   j["has_frame_times"] = run.has_frame_times;
   return jsonText(j);
 }
