@@ -1003,6 +1003,9 @@ Result runAndInterrupt(const std::string& args, const std::string& progress, int
     ::dup2(null, 0);
     ::dup2(null, 1);
     ::dup2(fds[1], 2);
+    // As a command typed at a terminal: SIGINT not ignored, whatever this test inherited (a
+    // background job of a script runs with it ignored, and semsegmap keeps it so).
+    ::signal(SIGINT, SIG_DFL);
     ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }

@@ -33,8 +33,13 @@ void installInterruptHandler() {
   sigemptyset(&action.sa_mask);
   // Reads of the data restart instead of failing with EINTR: the frame in hand finishes.
   action.sa_flags = SA_RESTART;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  for (const int signal : {SIGINT, SIGTERM}) {
+    // A signal the process was started deaf to (nohup, a background job of a script, whose
+    // shell ignores Ctrl-C for it) stays ignored: the terminal's Ctrl-C is not meant for it.
+    struct sigaction before {};
+    if (sigaction(signal, nullptr, &before) == 0 && before.sa_handler == SIG_IGN) continue;
+    sigaction(signal, &action, nullptr);
+  }
 }
 
 StopToken stopToken() {

@@ -15,8 +15,9 @@ namespace semsegmap::app {
 inline constexpr int kExitInterrupted = 130;
 
 // Installs the handlers (sigaction; the handler only sets a lock-free atomic flag, or on the
-// second signal _exits). For the commands that check stopToken() between frames only: any other
-// keeps the default action, so Ctrl-C still ends it at once.
+// second signal _exits), except for a signal the process inherited as ignored. For the commands
+// that check stopToken() between frames only: any other keeps the default action, so Ctrl-C still
+// ends it at once.
 void installInterruptHandler();
 StopToken stopToken();
 bool stopRequested();
