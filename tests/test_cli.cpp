@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -947,6 +948,172 @@ TEST(CliPoseFiles, WithoutGroundTruthOrTimesNothingIsMadeUp) {
   EXPECT_EQ(second[0], "1");
   EXPECT_EQ(second[1], "2");
   EXPECT_EQ(second[2], "");
+}
+
+// slam and odometry on data without frame times write no TUM file (its times would be made up
+// from the rate): the KITTI files carry the poses, a note says so, and `semsegmap view` reads
+// them.
+TEST(CliPoseFiles, WithoutFrameTimesNoTumFileIsWritten) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path data = copyOfDataset(tmp.path() / "data"), dir = tmp.path();
+  std::ofstream(dir / "odom.txt") << poseFilesOf(data, "odom_").kitti;
+  const std::string scans = " --dataset folder:" + (data / "lidar").string();
+  const Result slam =
+      run("slam" + scans + " --odometry " + (dir / "odom.txt").string() + " --config " +
+          eigenConfig(dir, "eigen.yaml") + " --out " + (dir / "slam").string());
+  ASSERT_EQ(slam.code, 0) << slam.err;
+  EXPECT_NE(slam.err.find("no trajectory_tum.txt or odometry_tum.txt"), std::string::npos)
+      << slam.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "slam" / "trajectory_tum.txt"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "slam" / "odometry_tum.txt"));
+  EXPECT_EQ(lines(readFile(dir / "slam" / "trajectory_kitti.txt")), 3u);
+  EXPECT_EQ(lines(readFile(dir / "slam" / "odometry_kitti.txt")), 3u);
+  EXPECT_NE(readFile(dir / "slam" / "summary.json").find("\"has_frame_times\": false"),
+            std::string::npos);
+
+  const Result odometry = run("odometry" + scans + " --out " + (dir / "odo").string());
+  ASSERT_EQ(odometry.code, 0) << odometry.err;
+  EXPECT_NE(odometry.err.find("no trajectory_tum.txt"), std::string::npos) << odometry.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "odo" / "trajectory_tum.txt"));
+  EXPECT_EQ(lines(readFile(dir / "odo" / "trajectory_kitti.txt")), 3u);
+  EXPECT_NE(readFile(dir / "odo" / "summary.json").find("\"has_frame_times\": false"),
+            std::string::npos);
+
+  // With the data's times (the simulator's) the TUM files are there.
+  const Result timed =
+      run("odometry --dataset " + data.string() + " --out " + (dir / "timed").string());
+  ASSERT_EQ(timed.code, 0) << timed.err;
+  EXPECT_EQ(lines(readFile(dir / "timed" / "trajectory_tum.txt")), 3u);
+  EXPECT_EQ(timed.err.find("no trajectory_tum.txt"), std::string::npos) << timed.err;
+}
+
+// Runs `semsegmap ARGS` with stderr into a pipe and stdout to /dev/null; once stderr shows
+// `progress`, sends `signals` SIGINTs to it, as a user pressing Ctrl-C. Returns the exit code
+// and all of stderr.
+Result runAndInterrupt(const std::string& args, const std::string& progress, int signals) {
+  Result r;
+  int fds[2];
+  if (::pipe(fds) != 0) return r;
+  const std::string command = "exec '" + g_binary + "' " + args;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::close(fds[0]);
+    const int null = ::open("/dev/null", O_RDWR);
+    ::dup2(null, 0);
+    ::dup2(null, 1);
+    ::dup2(fds[1], 2);
+    // As a command typed at a terminal: SIGINT not ignored, whatever this test inherited (a
+    // background job of a script runs with it ignored, and semsegmap keeps it so).
+    ::signal(SIGINT, SIG_DFL);
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::close(fds[1]);
+  char buffer[4096];
+  ssize_t n = 0;
+  bool sent = false;
+  while ((n = ::read(fds[0], buffer, sizeof buffer)) > 0) {
+    r.err.append(buffer, size_t(n));
+    if (sent || r.err.find(progress) == std::string::npos) continue;
+    for (int k = 0; k < signals; ++k) {
+      // Apart, or the kernel merges two pending ones into one; well within a frame (~0.3 s).
+      if (k > 0) ::usleep(20000);
+      ::kill(pid, SIGINT);
+    }
+    sent = true;
+  }
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// The files under `dir` whose names say they are an atomic write's temporary (".NAME.tmp-...").
+std::vector<std::string> temporaryFiles(const std::filesystem::path& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos)
+      found.push_back(e.path().string());
+  return found;
+}
+
+// Ctrl-C during a run: the frame in hand finishes, the frames done are written whole, one line
+// says so, summary.json says interrupted with the frames done, exit 130.
+TEST(CliInterrupt, CtrlCWritesTheFramesDoneAndExits130) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path out = tmp.path() / "slam";
+  const size_t total = 200;  // the whole run S2 of the tiny preset
+  const Result r = runAndInterrupt(
+      "slam --dataset sim:world=1,run=S2,preset=tiny,frames=" + std::to_string(total) +
+          " --config " + eigenConfig(tmp.path(), "eigen.yaml") + " --out " + out.string(),
+      "slam [", 1);
+  EXPECT_EQ(r.code, 130) << r.err;
+  const std::string prefix = "semsegmap slam: interrupted after ";
+  const size_t at = r.err.find(prefix);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(prefix, at + 1), std::string::npos) << r.err;  // one line
+  size_t done = 0, of = 0;
+  ASSERT_EQ(std::sscanf(r.err.c_str() + at + prefix.size(), "%zu of %zu frames", &done, &of), 2)
+      << r.err;
+  EXPECT_EQ(of, total);
+  EXPECT_GT(done, 0u);
+  EXPECT_LT(done, total);
+  const std::string line = r.err.substr(at, r.err.find('\n', at) - at);
+  EXPECT_EQ(line, prefix + std::to_string(done) + " of " + std::to_string(total) + " frames; " +
+                      out.string() + " holds the " + std::to_string(done) + " frames done");
+  const std::string summary = readFile(out / "summary.json");
+  EXPECT_NE(summary.find("\"interrupted\": true"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"frames\": " + std::to_string(done) + ","), std::string::npos)
+      << summary;
+  EXPECT_EQ(temporaryFiles(tmp.path()), std::vector<std::string>{});
+  // Every file whole: one pose per frame done, and the folder reads as a slam output (the view).
+  EXPECT_EQ(lines(readFile(out / "trajectory_tum.txt")), done);
+  EXPECT_EQ(lines(readFile(out / "trajectory_kitti.txt")), done);
+  EXPECT_EQ(readFile(out / "loops.csv").rfind("frame,old_frame,inliers,correction_m\n", 0), 0u);
+  EXPECT_TRUE(std::filesystem::exists(out / "slam.png"));
+}
+
+// A second Ctrl-C does not wait for the frame in hand: the process exits at once, with 130.
+TEST(CliInterrupt, ASecondCtrlCExitsAtOnce) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const Result r =
+      runAndInterrupt("odometry --dataset sim:world=1,run=S2,preset=tiny,frames=300 --out " +
+                          (tmp.path() / "odo").string(),
+                      "odometry [", 2);
+  EXPECT_EQ(r.code, 130) << r.err;
+  EXPECT_NE(r.err.find("interrupted again: exiting at once"), std::string::npos) << r.err;
+}
+
+// A label set stopped by Ctrl-C lists only the frames whose labels are complete, marked so.
+TEST(CliInterrupt, AnInterruptedLabelSetListsTheFramesDone) {
+  if (!built("simulate")) GTEST_SKIP() << "the pictures come from the simulator";
+  TempDir tmp;
+  const std::filesystem::path labels = tmp.path() / "labels";
+  const Result r = runAndInterrupt("label --dataset sim:preset=tiny,frames=300 --config " +
+                                       networkConfig(tmp.path()) + " --out " + labels.string(),
+                                   "label [", 1);
+  EXPECT_EQ(r.code, 130) << r.err;
+  const std::string prefix = "semsegmap label: interrupted after ";
+  const size_t at = r.err.find(prefix);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  size_t done = 0;
+  ASSERT_EQ(std::sscanf(r.err.c_str() + at + prefix.size(), "%zu", &done), 1);
+  const std::string yaml = readFile(labels / "labels.yaml");
+  EXPECT_NE(yaml.find("frames: " + std::to_string(done) + "\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("interrupted: true"), std::string::npos) << yaml;
+  const auto picture = [&labels](size_t frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06zu.png", frame);
+    return labels / "cam0" / name;
+  };
+  ASSERT_GT(done, 0u);
+  EXPECT_TRUE(std::filesystem::exists(picture(done - 1)));
+  EXPECT_FALSE(std::filesystem::exists(picture(done)));
+  EXPECT_EQ(temporaryFiles(tmp.path()), std::vector<std::string>{});
 }
 
 // map --out naming a directory or an unwritable place used to fail after every frame.

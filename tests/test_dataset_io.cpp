@@ -618,6 +618,54 @@ TEST(RunOutputs, AFailedRunRemovesWhatItCreatedAndNothingElse) {
   EXPECT_EQ(readText(old_dir / "mine.txt"), "before");
 }
 
+// Two runs in one process, one output inside the other's: each removes exactly its own new
+// files, and the one left alive keeps watching its own after the other is gone.
+TEST(RunOutputs, TwoAliveAtOnceEachRemoveOnlyTheirOwnFiles) {
+  TempDir tmp;
+  const fs::path a = tmp.path() / "a", b = tmp.path() / "b", inner = a / "inner";
+  fs::create_directories(inner);
+  fs::create_directories(b);
+  {
+    RunOutputs first;
+    first.folder(a);
+    {
+      RunOutputs second;
+      second.folder(b);
+      second.folder(inner);
+      writeBytesAtomically(a / "first.txt", "1");
+      writeBytesAtomically(inner / "second.txt", "2");  // the innermost output: second's
+      writeBytesAtomically(b / "second.txt", "2");
+    }  // second failed: its two files go, first's stays
+    EXPECT_EQ(entriesOf(tmp.path()),
+              (std::vector<std::string>{"a", "a/first.txt", "a/inner", "b"}));
+    writeBytesAtomically(inner / "first_after.txt", "1");  // no second any more: first's
+  }
+  EXPECT_EQ(entriesOf(tmp.path()), (std::vector<std::string>{"a", "a/inner", "b"}));
+}
+
+// The watches themselves: each of two sees its own new files, the innermost scope wins, and a
+// file replaced (not new) is reported to none.
+TEST(NewFileWatch, EachSeesTheNewFilesOfItsOwnScope) {
+  TempDir tmp;
+  const fs::path outer = tmp.path() / "outer", inner = outer / "inner";
+  fs::create_directories(inner);
+  std::vector<fs::path> outer_seen, inner_seen, file_seen;
+  NewFileWatch outer_watch(outer, [&](const fs::path& p) { outer_seen.push_back(p); });
+  {
+    NewFileWatch inner_watch(inner, [&](const fs::path& p) { inner_seen.push_back(p); });
+    NewFileWatch file_watch(outer / "one.txt", [&](const fs::path& p) { file_seen.push_back(p); });
+    writeBytesAtomically(outer / "x.txt", "x");
+    writeBytesAtomically(inner / "y.txt", "y");
+    writeBytesAtomically(outer / "one.txt", "1");
+    writeBytesAtomically(inner / "y.txt", "replaced");
+    writeBytesAtomically(tmp.path() / "elsewhere.txt", "z");
+  }
+  writeBytesAtomically(inner / "z.txt", "z");
+  EXPECT_EQ(outer_seen, (std::vector<fs::path>{outer / "x.txt", inner / "z.txt"}));
+  EXPECT_EQ(inner_seen, (std::vector<fs::path>{inner / "y.txt"}));
+  EXPECT_EQ(file_seen, (std::vector<fs::path>{outer / "one.txt"}));
+}
+
 TEST(RunOutputs, ACommittedRunKeepsEverything) {
   TempDir tmp;
   {

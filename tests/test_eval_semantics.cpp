@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -110,6 +111,20 @@ TEST(EvalSemantics, ClassesComeFromTheCamerasNotThePointLabels) {
   for (const auto& [id, n] : e.per_frame.false_positives) EXPECT_EQ(id, cls::kBuilding) << n;
   for (const auto& [id, n] : e.per_frame.true_positives) EXPECT_EQ(id, cls::kBuilding) << n;
   EXPECT_LT(e.per_frame.accuracy(), 0.5);
+}
+
+// A stop request (Ctrl-C) between frames: the scores are those of the frames done, marked.
+TEST(EvalSemantics, AStopRequestEndsItBetweenFrames) {
+  auto source = openDataset("sim:world=1,preset=tiny,frames=4");
+  std::atomic<bool> stop{false};
+  SemanticsEvalConfig c = simConfig();
+  c.stop = StopToken(stop);
+  const SemanticsEvaluation e =
+      evaluateSemantics(*source, c, [&](size_t done, size_t) { stop = done == 2; });
+  EXPECT_TRUE(e.interrupted);
+  ASSERT_EQ(e.frames.size(), 2u);
+  EXPECT_TRUE(toJson(e)["interrupted"].get<bool>());
+  EXPECT_EQ(toJson(e)["frames"].get<size_t>(), 2u);
 }
 
 TEST(EvalSemantics, RefusesWhatItCannotMeasureInOneLine) {

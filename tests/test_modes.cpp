@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -55,6 +56,54 @@ class OracleDescriber : public Describer {
 
 PipelineConfig semsegmapConfig() {
   return loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap.yaml");
+}
+
+// A stop request (Ctrl-C in the CLI) is checked between frames: the frame in hand finishes, no
+// further one starts, and the run says it was interrupted with the frames done.
+TEST(Modes, AStopRequestEndsTheRunBetweenFrames) {
+  auto source = openDataset("sim:world=1,run=S2,preset=tiny,frames=6");
+  std::atomic<bool> stop{false};
+  RunOptions options;
+  options.stop = StopToken(stop);
+  std::vector<size_t> processed, reported;
+  options.progress = [&](size_t done, size_t total) {
+    EXPECT_EQ(total, 6u);
+    reported.push_back(done);
+  };
+  // Asked while frame 2 is processed: frame 2 is finished, frame 3 never starts.
+  const bool whole = feedFrames(*source, options, [&](const Frame& frame) {
+    processed.push_back(frame.index);
+    if (frame.index == 2) stop = true;
+  });
+  EXPECT_FALSE(whole);
+  EXPECT_EQ(processed, (std::vector<size_t>{0, 1, 2}));
+  EXPECT_EQ(reported, (std::vector<size_t>{1, 2, 3}));
+
+  // A whole mapping run of the frames done, marked interrupted.
+  stop = false;
+  options.progress = [&](size_t done, size_t) { stop = stop || done == 2; };
+  const MappingRun map = runMapping(*source, semsegmapConfig(), PoseSource::kGroundTruth,
+                                    std::make_shared<OracleDescriber>(), options);
+  EXPECT_TRUE(map.stats.interrupted);
+  EXPECT_EQ(map.stats.frames, 2u);
+  EXPECT_EQ(map.trajectory.size(), 2u);
+
+  // Asked before the first frame: nothing done, and finishing the empty run is safe.
+  stop = true;
+  options.progress = nullptr;
+  const SlamRun slam =
+      runSlam(*source, semsegmapConfig(), std::make_shared<OracleDescriber>(), options);
+  EXPECT_TRUE(slam.stats.interrupted);
+  EXPECT_EQ(slam.stats.frames, 0u);
+  EXPECT_TRUE(slam.trajectory.empty());
+  EXPECT_TRUE(nlohmann::json::parse(slamSummaryJson(slam, "tiny"))["interrupted"].get<bool>());
+
+  // Without a request every frame runs and nothing says interrupted.
+  stop = false;
+  const MappingRun all = runMapping(*source, semsegmapConfig(), PoseSource::kGroundTruth,
+                                    std::make_shared<OracleDescriber>(), options);
+  EXPECT_FALSE(all.stats.interrupted);
+  EXPECT_EQ(all.stats.frames, 6u);
 }
 
 TEST(Modes, MapSaveLoadAndLocalizeAnotherRunOfTheSamePlace) {

@@ -339,5 +339,22 @@ TEST(RunFolders, SlamFolderAndItsLoopsAgainstTheTrajectory) {
   EXPECT_ONE_LINE(e);
 }
 
+// A slam run over data without frame times writes KITTI files alone: the view reads them; the
+// TUM files win where both are there.
+TEST(RunFolders, ASlamFolderWithoutTimesIsReadFromItsKittiFiles) {
+  TempDir tmp;
+  std::vector<StampedPose> poses;
+  for (int i = 0; i < 3; ++i) poses.push_back({0.1 * i, planarPose(i, 0, 0, 0)});
+  writeKitti(tmp.path() / "trajectory_kitti.txt", poses);
+  writeKitti(tmp.path() / "odometry_kitti.txt", {poses[0], poses[1]});
+  SlamFolder f = readSlamFolder(tmp.path());
+  ASSERT_EQ(f.trajectory.size(), 3u);
+  EXPECT_NEAR(f.trajectory[2].T.translation().x(), 2.0, 1e-9);
+  EXPECT_EQ(f.odometry.size(), 2u);
+  writeTum(tmp.path() / "trajectory_tum.txt", {poses[0]});
+  f = readSlamFolder(tmp.path());
+  EXPECT_EQ(f.trajectory.size(), 1u);
+}
+
 }  // namespace
 }  // namespace semsegmap

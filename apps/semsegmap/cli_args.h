@@ -49,6 +49,9 @@ struct CommandSpec {
   std::vector<OptionSpec> options;
   std::string notes;  // printed after the options; may be empty
   int (*run)(const CliArgs&) = nullptr;
+  // Ctrl-C asks it to stop between frames (apps/semsegmap/interrupt.h): it writes the frames
+  // done and exits 130. Any other command is ended at once by the signal's default action.
+  bool stops_between_frames = false;
 };
 
 // `semsegmap CMD --help`: usage, summary, one line per option with its default, the notes.

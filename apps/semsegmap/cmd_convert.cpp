@@ -5,6 +5,7 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/io/dataset_writer.h"
 
@@ -17,12 +18,16 @@ int runConvert(const CliArgs& a) {
   const size_t n = a.frameLimit(source->size());
   DatasetWriter writer(a.get("out"), source->info());
   Progress progress("convert", n);
-  for (size_t i = 0; i < n; ++i) {
+  // Each frame's files and frames.csv row are whole when the next starts: a stopped
+  // conversion is a readable dataset of the frames written.
+  for (size_t i = 0; i < n && !stopRequested(); ++i) {
     writer.write(source->frame(i));
     progress.update(i + 1);
   }
   std::cout << "wrote " << writer.framesWritten() << " frames of " << source->info().name << " to "
             << a.get("out") << "\n";
+  if (writer.framesWritten() < n)
+    return interruptedRun("convert", writer.framesWritten(), n, a.get("out"));
   return 0;
 }
 
@@ -30,7 +35,8 @@ int runConvert(const CliArgs& a) {
 
 const CommandSpec& convertCommand() {
   static const CommandSpec command{
-      "convert", "writes any dataset the command line reads in the project's own format",
+      "convert",
+      "writes any dataset the command line reads in the project's own format",
       datasetOptions("the dataset to convert",
                      {
                          {"out", Value::kText, "DIR", "", "dataset directory to write", kRequired},
@@ -39,7 +45,9 @@ const CommandSpec& convertCommand() {
                           "a config whose semantics: section labels the pictures that have no "
                           "labels, so that the written dataset carries them"},
                      }),
-      kDatasetNotes, runConvert};
+      kDatasetNotes,
+      runConvert,
+      /*stops_between_frames=*/true};
   return command;
 }
 

@@ -8,6 +8,7 @@
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "eval_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/eval/semantics_experiment.h"
@@ -22,13 +23,18 @@ int runEvalSemantics(const CliArgs& a) {
   SemanticsEvalConfig c;
   c.pipeline = loadPipelineConfig(config);
   c.max_frames = a.frameLimit();
+  c.stop = stopToken();
   const std::unique_ptr<FrameSource> source = openDatasetArg(a, config);
   Progress progress("eval semantics", a.frameLimit(source->size()));
   const SemanticsEvaluation e =
       evaluateSemantics(*source, c, [&](size_t done, size_t) { progress.update(done); });
+  const size_t total = a.frameLimit(source->size());
+  // Stopped before its first frame: no scores of nothing (main removes what the run made).
+  if (e.interrupted && e.frames.empty()) return interruptedRun("eval semantics", 0, total, "");
   std::filesystem::create_directories(out);
   writeJsonAtomically(out / "semantics.json", toJson(e));
   std::cout << semanticsTable(e) << "wrote " << (out / "semantics.json").string() << "\n";
+  if (e.interrupted) return interruptedRun("eval semantics", e.frames.size(), total, out.string());
   return 0;
 }
 
@@ -45,7 +51,9 @@ const CommandSpec& evalSemanticsCommand() {
             "gives the camera classes unless --labels does (default: shipped)"},
            {"out", Value::kText, "DIR", "", "output folder", kRequired},
            maxFramesOption()}),
-      "", runEvalSemantics};
+      "",
+      runEvalSemantics,
+      /*stops_between_frames=*/true};
   return semantics;
 }
 

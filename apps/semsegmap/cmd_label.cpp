@@ -7,6 +7,7 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/datasets/semantic_sources.h"
 #include "semsegmap/io/image_io.h"
@@ -58,12 +59,19 @@ int runLabel(const CliArgs& a) {
   size_t written = 0;
   bool preview = false;
   Progress progress("label", n);
-  for (size_t i = 0; i < n; ++i) {
-    written += writeFrameLabels(source->frame(i), i, info, out, preview);
-    progress.update(i + 1);
+  size_t done = 0;
+  for (; done < n && !stopRequested(); ++done) {
+    written += writeFrameLabels(source->frame(done), done, info, out, preview);
+    progress.update(done + 1);
   }
+  if (done == 0) return interruptedRun("label", 0, n, "");  // main removes the empty set
+  // Stopped early (Ctrl-C), the set is kept and lists only the frames done: their pictures are
+  // whole (written atomically, a frame at a time), the network's cost for them is paid, and
+  // --labels refuses a run that reads beyond them (LabelSetInfo::frames). `interrupted` says
+  // why it is short; removing the set would throw that work away for nothing.
   LabelSetInfo set;
-  set.frames = n;  // the frames labelled, not the dataset's
+  set.frames = done;  // the frames labelled, not the dataset's
+  set.interrupted = done < n;
   set.dataset_frames = source->size();
   set.cameras = info.rig.cameras.size();
   set.dataset = a.get("dataset");
@@ -71,11 +79,12 @@ int runLabel(const CliArgs& a) {
   writeLabelSetInfo(out, set);
 
   const LabelingStats& s = labelerOf(*source)->stats();
-  std::printf("frames %zu  label images %zu: network %zu (%.1f ms each), reused %zu, kept %zu\n", n,
-              written, s.network_runs, s.network_runs ? s.network_ms / s.network_runs : 0.0,
+  std::printf("frames %zu  label images %zu: network %zu (%.1f ms each), reused %zu, kept %zu\n",
+              done, written, s.network_runs, s.network_runs ? s.network_ms / s.network_runs : 0.0,
               s.reused, s.kept);
   std::cout << "wrote " << out.string() << " (labels.yaml, cam*/, preview.png); read it with "
             << "--labels " << out.string() << "\n";
+  if (set.interrupted) return interruptedRun("label", done, n, out.string());
   return 0;
 }
 
@@ -93,7 +102,9 @@ const CommandSpec& labelCommand() {
                          maxFramesOption(),
                      },
                      false),
-      kDatasetNotes, runLabel};
+      kDatasetNotes,
+      runLabel,
+      /*stops_between_frames=*/true};
   return command;
 }
 

@@ -5,6 +5,7 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -68,7 +69,11 @@ int runLocalize(const CliArgs& a) {
   RunOptions options;
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
+  options.stop = stopToken();
   const LocalizationRun run = runLocalization(*source, config, map, describer, options, settings);
+  // Stopped before its first frame: nothing worth writing (main removes what the run made).
+  if (run.stats.interrupted && run.stats.frames == 0)
+    return interruptedRun("localize", 0, options.frameCount(*source), out.string());
 
   writeLocalizationsCsv(out / "localizations.csv", run);
   writeLocalizationDetails(out, run);  // matches.csv, trajectory.csv: for semsegmap view
@@ -88,6 +93,8 @@ int runLocalize(const CliArgs& a) {
   printLocalizationSummary(run);
   std::cout << "wrote " << (out / "localizations.csv").string()
             << ", matches.csv, trajectory.csv, summary.json, localization.png\n";
+  if (run.stats.interrupted)
+    return interruptedRun("localize", run.stats.frames, options.frameCount(*source), out.string());
   return 0;
 }
 
@@ -95,7 +102,8 @@ int runLocalize(const CliArgs& a) {
 
 const CommandSpec& localizeCommand() {
   static const CommandSpec command{
-      "localize", "localizes a run against a target map -> localizations.csv, summary.json, .png",
+      "localize",
+      "localizes a run against a target map -> localizations.csv, summary.json, .png",
       datasetOptions(
           "the run to localize",
           {
@@ -107,7 +115,9 @@ const CommandSpec& localizeCommand() {
               {"allow-config-mismatch", Value::kFlag, "", "",
                "localize even when the map was built with other settings (listed on stderr)"},
           }),
-      kDatasetNotes, runLocalize};
+      kDatasetNotes,
+      runLocalize,
+      /*stops_between_frames=*/true};
   return command;
 }
 

@@ -4,6 +4,7 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -38,6 +39,8 @@ int runMap(const CliArgs& a) {
   RunOptions options;
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
+  // The map of the frames done is whole and usable: saved as any other.
+  options.stop = stopToken();
   TargetMap map;
   RunStats stats;
   size_t segments = 0, earlier = 0, duplicates = 0;
@@ -54,6 +57,9 @@ int runMap(const CliArgs& a) {
     earlier = run.earlier_observations;
     duplicates = run.duplicates_removed;
   }
+  // Stopped before its first frame: no map of nothing.
+  if (stats.interrupted && stats.frames == 0)
+    return interruptedRun("map", 0, options.frameCount(*source), out.string());
   MapWriteOptions write;
   write.float16 = !a.has("float32");
   const uint64_t bytes = saveTargetMap(out, map, write);
@@ -66,6 +72,8 @@ int runMap(const CliArgs& a) {
       static_cast<unsigned long long>(bytes),
       map.size() ? static_cast<double>(bytes) / map.size() : 0.0, stats.fps());
   std::cout << "wrote " << out.string() << "\n";
+  if (stats.interrupted)
+    return interruptedRun("map", stats.frames, options.frameCount(*source), out.string());
   return 0;
 }
 
@@ -73,7 +81,8 @@ int runMap(const CliArgs& a) {
 
 const CommandSpec& mapCommand() {
   static const CommandSpec command{
-      "map", "builds a target map from a mapping run and saves it (docs/map-format.md)",
+      "map",
+      "builds a target map from a mapping run and saves it (docs/map-format.md)",
       datasetOptions(
           "the mapping run",
           {
@@ -88,7 +97,9 @@ const CommandSpec& mapCommand() {
                "(default: the config's target_map.max_points_per_segment)"},
               {"float32", Value::kFlag, "", "", "store descriptors as float32 instead of float16"},
           }),
-      kDatasetNotes, runMap};
+      kDatasetNotes,
+      runMap,
+      /*stops_between_frames=*/true};
   return command;
 }
 

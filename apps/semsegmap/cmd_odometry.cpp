@@ -1,13 +1,15 @@
 // semsegmap odometry: LiDAR odometry over a dataset, from its scans alone; writes the trajectory
-// (TUM and KITTI formats), summary.json and, with ground truth, the KITTI relative error, the ATE
-// and trajectory.png.
+// (TUM and KITTI formats; KITTI alone when the data has no frame times), summary.json and, with
+// ground truth, the KITTI relative error, the ATE and trajectory.png.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/eval/odometry_run.h"
 #include "semsegmap/settings/config.h"
 
@@ -21,9 +23,12 @@ int runOdometryCommand(const CliArgs& a) {
   const std::filesystem::path out = a.get("out");
   auto source = openDatasetArg(a);
   Progress progress("odometry", 0);
-  const OdometryRun run =
-      runLidarOdometry(*source, config, a.frameLimit(),
-                       [&](size_t done, size_t total) { progress.update(done, total); });
+  const OdometryRun run = runLidarOdometry(
+      *source, config, a.frameLimit(),
+      [&](size_t done, size_t total) { progress.update(done, total); }, stopToken());
+  const size_t total = framesToRead(*source, a.frameLimit());
+  // Stopped before its first frame: nothing worth writing (main removes what the run made).
+  if (run.interrupted && run.frames.empty()) return interruptedRun("odometry", 0, total, "");
   writeOdometryFiles(out, run);
   const std::optional<OdometryErrors> errors = odometryErrors(run);
   size_t predicted = 0;
@@ -41,8 +46,16 @@ int runOdometryCommand(const CliArgs& a) {
         errors->kitti.segments.size(), errors->ate.rmse_m, errors->ate_aligned.rmse_m);
   else
     std::printf("no ground truth: errors unknown\n");
-  std::cout << "wrote " << (out / "trajectory_tum.txt").string()
-            << ", trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << "\n";
+  // A TUM file needs the data's times: without them one made up from the rate would pair the
+  // poses with the wrong data, so only the KITTI file is written (odometry_run.h).
+  if (!run.has_frame_times)
+    note(
+        "the data has no frame times: no trajectory_tum.txt (its times would be made up); "
+        "trajectory_kitti.txt holds the poses, line i for frame i of the run");
+  std::cout << "wrote " << (run.has_frame_times ? "trajectory_tum.txt, " : "")
+            << "trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << " to "
+            << out.string() << "\n";
+  if (run.interrupted) return interruptedRun("odometry", run.frames.size(), total, out.string());
   return 0;
 }
 
@@ -60,7 +73,9 @@ const CommandSpec& odometryCommand() {
                          maxFramesOption(),
                      },
                      /*odometry_option=*/false, /*labels_option=*/false),
-      kDatasetNotes, runOdometryCommand};
+      kDatasetNotes,
+      runOdometryCommand,
+      /*stops_between_frames=*/true};
   return command;
 }
 

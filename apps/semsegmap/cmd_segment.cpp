@@ -5,6 +5,7 @@
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/artefacts/segments_io.h"
 #include "semsegmap/pipeline/pipeline.h"
@@ -53,8 +54,9 @@ int runSegment(const CliArgs& a) {
   size_t merges = 0;
   Progress progress("segment", n);
   std::vector<std::optional<size_t>> numbers;  // the dataset's own, by frame index
-  for (size_t i = 0; i < n; ++i) {
-    const Frame frame = source->frame(i);
+  size_t done = 0;
+  for (; done < n && !stopRequested(); ++done) {
+    const Frame frame = source->frame(done);
     if (numbers.size() <= frame.index) numbers.resize(frame.index + 1);
     numbers[frame.index] = frame.number;
     FrameResult r = pipeline.process(frame);
@@ -64,8 +66,9 @@ int runSegment(const CliArgs& a) {
     total.enrich_ms += r.times.enrich_ms;
     total.local_map_ms += r.times.local_map_ms;
     total.segment_ms += r.times.segment_ms;
-    progress.update(i + 1);
+    progress.update(done + 1);
   }
+  if (done == 0) return interruptedRun("segment", 0, n, "");
   for (auto& s : pipeline.finish()) segments.push_back(std::move(s));
   std::sort(segments.begin(), segments.end(),
             [](const Segment& x, const Segment& y) { return x.id < y.id; });
@@ -77,8 +80,9 @@ int runSegment(const CliArgs& a) {
       out / "segments.png", segments, trajectory,
       source->info().name + " - " + std::filesystem::path(a.get("config")).stem().string());
 
-  printSummary(segments, n, merges, has_gt, total);
+  printSummary(segments, done, merges, has_gt, total);
   std::cout << "wrote " << (out / "segments.csv").string() << ", segments.ply, segments.png\n";
+  if (done < n) return interruptedRun("segment", done, n, out.string());
   return 0;
 }
 
@@ -86,7 +90,8 @@ int runSegment(const CliArgs& a) {
 
 const CommandSpec& segmentCommand() {
   static const CommandSpec command{
-      "segment", "enrichment + local map + incremental segmentation -> segments.csv, .ply, .png",
+      "segment",
+      "enrichment + local map + incremental segmentation -> segments.csv, .ply, .png",
       datasetOptions(
           "the dataset",
           {
@@ -97,7 +102,9 @@ const CommandSpec& segmentCommand() {
                "poses the local map is built with (default: gt when the data has them, else odom)"},
               maxFramesOption(),
           }),
-      kDatasetNotes, runSegment};
+      kDatasetNotes,
+      runSegment,
+      /*stops_between_frames=*/true};
   return command;
 }
 

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "cli_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/io/dataset_writer.h"
 #include "semsegmap/sim/simulator.h"
@@ -23,13 +24,16 @@ int runSimulate(const CliArgs& a) {
   sim::Simulator simulator(config);
   DatasetWriter writer(out, simulator.info());
   Progress progress("simulate " + sim::runName(config.run), simulator.size());
-  for (size_t i = 0; i < simulator.size(); ++i) {
+  // As convert: a stopped run is a readable dataset of the frames written.
+  for (size_t i = 0; i < simulator.size() && !stopRequested(); ++i) {
     writer.write(simulator.frame(i));
     progress.update(i + 1);
   }
   std::cout << "wrote " << writer.framesWritten() << " frames (" << simulator.trajectory().length_m
             << " m, " << simulator.lighting().name << ", traffic seed " << simulator.trafficSeed()
             << ") to " << out << "\n";
+  if (writer.framesWritten() < simulator.size())
+    return interruptedRun("simulate", writer.framesWritten(), simulator.size(), out);
   return 0;
 }
 
@@ -52,7 +56,8 @@ const CommandSpec& simulateCommand() {
           {"no-cameras", Value::kFlag, "", "", "LiDAR only: do not render the cameras"},
       },
       "",
-      runSimulate};
+      runSimulate,
+      /*stops_between_frames=*/true};
   return command;
 }
 

@@ -1,14 +1,17 @@
 // semsegmap slam: mapping on odometry with loop closure in a pose graph; writes the trajectory
-// (TUM and KITTI formats), the loop closures, the error before and after, and a picture.
+// (TUM and KITTI formats; KITTI alone when the data has no frame times), the loop closures, the
+// error before and after, and a picture.
 #include <filesystem>
 #include <iostream>
 #include <optional>
 
 #include "cli_args.h"
 #include "dataset_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/io/trajectory_file.h"
 #include "semsegmap/outputs/run_output.h"
 #include "semsegmap/pipeline/slam.h"
@@ -18,6 +21,25 @@
 namespace semsegmap::app {
 
 namespace {
+
+// The loop-closed and the odometry trajectory; the names of the files written. TUM files carry
+// times, and a time made up from the frame rate would pair the poses with the wrong data in evo
+// or with another sensor's log: without the data's times only KITTI files (one line per frame
+// of the run, in order) are written, and a note says so.
+std::string writeTrajectories(const std::filesystem::path& out, const SlamRun& run) {
+  writeKitti(out / "trajectory_kitti.txt", run.trajectory);
+  if (!run.has_frame_times) {
+    writeKitti(out / "odometry_kitti.txt", run.trajectory_odom);
+    note(
+        "the data has no frame times: no trajectory_tum.txt or odometry_tum.txt (their times "
+        "would be made up); trajectory_kitti.txt and odometry_kitti.txt hold the poses, line i "
+        "for frame i of the run");
+    return "trajectory_kitti.txt, odometry_kitti.txt";
+  }
+  writeTum(out / "trajectory_tum.txt", run.trajectory);
+  writeTum(out / "odometry_tum.txt", run.trajectory_odom);
+  return "trajectory_tum.txt, trajectory_kitti.txt, odometry_tum.txt";
+}
 
 int runSlamCommand(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
@@ -30,11 +52,13 @@ int runSlamCommand(const CliArgs& a) {
   RunOptions options;
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
+  options.stop = stopToken();
   const SlamRun run = runSlam(*source, config, describer, options);
+  // Stopped before its first frame: nothing worth writing (main removes what the run made).
+  if (run.stats.interrupted && run.stats.frames == 0)
+    return interruptedRun("slam", 0, options.frameCount(*source), out.string());
 
-  writeTum(out / "trajectory_tum.txt", run.trajectory);
-  writeKitti(out / "trajectory_kitti.txt", run.trajectory);
-  writeTum(out / "odometry_tum.txt", run.trajectory_odom);
+  const std::string trajectories = writeTrajectories(out, run);
   writeFileAtomically(out / "loops.csv", [&](std::ostream& o) {
     o << "frame,old_frame,inliers,correction_m\n";
     for (const LoopClosure& l : run.loops)
@@ -65,8 +89,10 @@ int runSlamCommand(const CliArgs& a) {
   writeBytesAtomically(out / "summary.json", slamSummaryJson(run, source->info().name));
   std::printf("frames %zu  loop closures %zu  map segments %zu  %.1f Hz\n", run.stats.frames,
               run.loops.size(), run.map.size(), run.stats.fps());
-  std::cout << "wrote " << (out / "trajectory_tum.txt").string()
-            << ", trajectory_kitti.txt, odometry_tum.txt, loops.csv, summary.json, slam.png\n";
+  std::cout << "wrote " << trajectories << ", loops.csv, summary.json, slam.png to " << out.string()
+            << "\n";
+  if (run.stats.interrupted)
+    return interruptedRun("slam", run.stats.frames, options.frameCount(*source), out.string());
   return 0;
 }
 
@@ -74,7 +100,8 @@ int runSlamCommand(const CliArgs& a) {
 
 const CommandSpec& slamCommand() {
   static const CommandSpec command{
-      "slam", "mapping with loop closure on odometry -> trajectories, loops.csv, slam.png",
+      "slam",
+      "mapping with loop closure on odometry -> trajectories, loops.csv, slam.png",
       datasetOptions("the run to map",
                      {
                          {"config", Value::kText, "FILE", "",
@@ -82,7 +109,9 @@ const CommandSpec& slamCommand() {
                          {"out", Value::kText, "DIR", "", "output folder", kRequired},
                          maxFramesOption(),
                      }),
-      kDatasetNotes, runSlamCommand};
+      kDatasetNotes,
+      runSlamCommand,
+      /*stops_between_frames=*/true};
   return command;
 }
 

@@ -10,6 +10,7 @@
 
 #include "cli_args.h"
 #include "eval_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/outputs/run_output.h"
@@ -254,8 +255,10 @@ int run(const std::vector<std::string>& args, bool check_only) {
     });
     RunOutputs outputs;  // a failed command leaves none of its outputs behind
     declareOutputs(parsed, outputs);
+    if (command->stops_between_frames) installInterruptHandler();
     const int code = command->run(parsed);
-    if (code == 0) outputs.commit();
+    // An interrupted run wrote the frames it did as whole outputs: they stay.
+    if (code == 0 || (code == kExitInterrupted && interruptedRunKeepsOutputs())) outputs.commit();
     return code;
   } catch (const UsageError& e) {
     endProgressLine();

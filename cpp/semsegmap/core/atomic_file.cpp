@@ -2,14 +2,18 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 namespace semsegmap {
 namespace fs = std::filesystem;
@@ -25,20 +29,53 @@ fs::path temporaryPathFor(const fs::path& path) {
   return path.parent_path() / name.str();
 }
 
-std::mutex& observerMutex() {
-  static std::mutex m;
-  return m;
-}
-std::function<void(const fs::path&)>& newFileObserver() {
-  static std::function<void(const fs::path&)> observer;
-  return observer;
+// Absolute, without "." and ".." or a trailing separator: how scopes and files are compared.
+fs::path normalizedPath(const fs::path& path) {
+  fs::path p = fs::absolute(path).lexically_normal();
+  if (p.filename().empty() && p.has_relative_path()) p = p.parent_path();
+  return p;
 }
 
-// After the rename: `existed` is whether `path` was there before it.
+// The scope itself, or a path below it: how many levels down, or -1 outside it.
+int depthBelow(const fs::path& path, const fs::path& scope) {
+  const fs::path rel = path.lexically_relative(scope);
+  if (rel.empty() || *rel.begin() == "..") return -1;
+  if (rel == ".") return 0;
+  return static_cast<int>(std::distance(rel.begin(), rel.end()));
+}
+
+struct Watch {
+  size_t id;
+  fs::path scope;
+  std::function<void(const fs::path&)> observer;
+};
+
+// The watches alive; observers are called with the mutex held, so that a watch that is being
+// removed waits for a call in progress and is never called after its destructor returned.
+struct WatchRegistry {
+  std::mutex mutex;
+  std::vector<Watch> watches;
+  size_t next_id = 0;
+};
+WatchRegistry& watchRegistry() {
+  static WatchRegistry registry;
+  return registry;
+}
+
+// After the rename: `existed` is whether `path` was there before it. The nearest scope wins.
 void reportNewFile(const fs::path& path, bool existed) {
   if (existed) return;
-  const std::lock_guard<std::mutex> lock(observerMutex());
-  if (newFileObserver()) newFileObserver()(path);
+  WatchRegistry& r = watchRegistry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  if (r.watches.empty()) return;
+  const fs::path full = normalizedPath(path);
+  int nearest = std::numeric_limits<int>::max();
+  for (const Watch& w : r.watches) {
+    const int depth = depthBelow(full, w.scope);
+    if (depth >= 0) nearest = std::min(nearest, depth);
+  }
+  for (const Watch& w : r.watches)
+    if (depthBelow(full, w.scope) == nearest) w.observer(full);
 }
 
 void removeQuietly(const fs::path& path) {
@@ -76,9 +113,19 @@ void writeFileAtomically(const fs::path& path, const std::function<void(std::ost
   }
 }
 
-void setNewFileObserver(std::function<void(const fs::path&)> observer) {
-  const std::lock_guard<std::mutex> lock(observerMutex());
-  newFileObserver() = std::move(observer);
+NewFileWatch::NewFileWatch(const fs::path& scope, std::function<void(const fs::path&)> observer) {
+  WatchRegistry& r = watchRegistry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  id_ = r.next_id++;
+  r.watches.push_back({id_, normalizedPath(scope), std::move(observer)});
+}
+
+NewFileWatch::~NewFileWatch() {
+  WatchRegistry& r = watchRegistry();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  r.watches.erase(std::remove_if(r.watches.begin(), r.watches.end(),
+                                 [this](const Watch& w) { return w.id == id_; }),
+                  r.watches.end());
 }
 
 void writeBytesAtomically(const fs::path& path, const std::string& bytes) {

@@ -15,10 +15,23 @@ void writeFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write);
 void writeBytesAtomically(const std::filesystem::path& path, const std::string& bytes);
 
-// Called with every file the writes above put in place where none was before, from any thread
-// (one at a time): outputs/run_output.h's RunOutputs records them, to remove the files of a command
-// that fails. An empty function (the default) turns it off.
-void setNewFileObserver(std::function<void(const std::filesystem::path&)> observer);
+// While alive, calls observer(path) with every file the writes above put in place where none was
+// before under `scope` (a folder, or one file): outputs/run_output.h's RunOutputs records them, to
+// remove the files of a command that fails. From any thread, one call at a time. A file goes only
+// to the watches of the innermost scope that holds it, so that watches of different outputs, alive
+// at once (two runs in one process), never see each other's files; watches of the same scope all
+// see it. Paths are compared absolute and normalised, as given (symbolic links are not resolved).
+class NewFileWatch {
+ public:
+  NewFileWatch(const std::filesystem::path& scope,
+               std::function<void(const std::filesystem::path&)> observer);
+  ~NewFileWatch();
+  NewFileWatch(const NewFileWatch&) = delete;
+  NewFileWatch& operator=(const NewFileWatch&) = delete;
+
+ private:
+  size_t id_;
+};
 
 // Whole file as bytes; throws std::runtime_error "<path>: cannot open" when missing/unreadable.
 std::string readFileBytes(const std::filesystem::path& path);

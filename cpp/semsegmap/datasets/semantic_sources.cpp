@@ -107,7 +107,8 @@ void checkLabelSetFrames(const LabelSetInfo& set, const std::filesystem::path& d
     throw std::runtime_error(dir.string() + ": the label set labels frames 0 to " +
                              std::to_string(set.frames - 1) + " only, this run reads " +
                              std::to_string(frames_needed) + " frames (label them all, or give " +
-                             optionText("max-frames", std::to_string(set.frames)) + ")");
+                             optionText("max-frames", std::to_string(set.frames)) + ")" +
+                             (set.interrupted ? "; its labelling was interrupted" : ""));
 }
 
 }  // namespace

@@ -11,14 +11,20 @@
 namespace semsegmap {
 
 OdometryRun runLidarOdometry(FrameSource& source, const OdometryConfig& config, size_t max_frames,
-                             const std::function<void(size_t, size_t)>& progress) {
+                             const std::function<void(size_t, size_t)>& progress,
+                             const StopToken& stop) {
   OdometryRun run;
   run.dataset = source.info().name;
+  run.has_frame_times = source.info().has_frame_times;
   const Pose T_base_lidar = source.info().rig.T_base_lidar;
   LidarOdometry odometry(config);
   const size_t n = framesToRead(source, max_frames);
   bool all_ground_truth = true;
   for (size_t i = 0; i < n; ++i) {
+    if (stop.stopRequested()) {
+      run.interrupted = true;
+      break;
+    }
     const Frame f = source.frame(i);
     const auto start = std::chrono::steady_clock::now();
     const OdometryResult r = odometry.registerFrame(f.points, f.point_times, f.timestamp_s);
@@ -73,6 +79,7 @@ nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<Odomet
   nlohmann::ordered_json j;
   j["dataset"] = run.dataset;
   j["frames"] = run.frames.size();
+  j["interrupted"] = run.interrupted;  // `frames` are those done before Ctrl-C
   j["seconds"] = run.seconds;
   j["ms_per_frame"] = run.frames.empty()
                           ? nlohmann::ordered_json(nullptr)
@@ -81,6 +88,8 @@ nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<Odomet
   // Without ground truth the errors are unknown: null, as in every summary.
   using Json = nlohmann::ordered_json;
   j["has_ground_truth"] = errors.has_value();
+  // false: no trajectory_tum.txt, its times would be made up (trajectory_kitti.txt has the poses).
+  j["has_frame_times"] = run.has_frame_times;
   j["kitti_relative_error"] = errors ? toJson(errors->kitti) : Json(nullptr);
   j["ate"] = errors ? toJson(errors->ate) : Json(nullptr);
   j["ate_aligned"] = errors ? toJson(errors->ate_aligned) : Json(nullptr);
@@ -89,7 +98,7 @@ nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<Odomet
 
 void writeOdometryFiles(const std::filesystem::path& out, const OdometryRun& run) {
   std::filesystem::create_directories(out);
-  writeTum(out / "trajectory_tum.txt", run.trajectory);
+  if (run.has_frame_times) writeTum(out / "trajectory_tum.txt", run.trajectory);
   writeKitti(out / "trajectory_kitti.txt", run.trajectory);
   const std::optional<OdometryErrors> errors = odometryErrors(run);
   writeJsonAtomically(out / "summary.json", toJson(run, errors));

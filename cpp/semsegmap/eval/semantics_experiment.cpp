@@ -159,6 +159,10 @@ SemanticsEvaluation evaluateSemantics(FrameSource& source, const SemanticsEvalCo
   const size_t n =
       config.max_frames == 0 ? source.size() : std::min(config.max_frames, source.size());
   for (size_t k = 0; k < n; ++k) {
+    if (config.stop.stopRequested()) {
+      e.interrupted = true;
+      break;
+    }
     Frame frame = source.frame(k);
     const std::vector<PointLabel> truth = takeTruth(frame, info.name);
     const FrameResult result = pipeline.process(frame);
@@ -196,6 +200,7 @@ nlohmann::ordered_json toJson(const SemanticsEvaluation& e) {
   nlohmann::ordered_json j;
   j["dataset"] = e.dataset;
   j["frames"] = e.frames.size();
+  j["interrupted"] = e.interrupted;  // `frames` are those done before Ctrl-C
   j["per_frame"] = toJson(e.per_frame, e.classes);
   j["after_votes"] = toJson(e.after_votes, e.classes);
   j["segments"] = {{"count", e.segments},

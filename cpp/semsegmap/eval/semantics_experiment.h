@@ -12,6 +12,7 @@
 
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/core/json.h"
+#include "semsegmap/core/stop_token.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
 namespace semsegmap {
@@ -48,11 +49,14 @@ struct SemanticsEvaluation {
   // The map segments (every finished segment's last observation, as the map keeps it) and those
   // with a class: at least one of the observation's points has one.
   size_t segments = 0, segments_with_class = 0;
+  // SemanticsEvalConfig::stop ended it early: the scores are those of `frames`, the frames done.
+  bool interrupted = false;
 };
 
 struct SemanticsEvalConfig {
   PipelineConfig pipeline;  // enrichment, local map (voxel size, radius) and segmentation
   size_t max_frames = 0;    // 0: all
+  StopToken stop;           // checked before each frame (Ctrl-C in the CLI)
 };
 
 using SemanticsProgress = std::function<void(size_t done, size_t total)>;

@@ -18,6 +18,7 @@ void writeLabelSetInfo(const std::filesystem::path& dir, const LabelSetInfo& inf
   out << YAML::Key << "cameras" << YAML::Value << info.cameras;
   out << YAML::Key << "dataset" << YAML::Value << info.dataset;
   out << YAML::Key << "model" << YAML::Value << info.model;
+  if (info.interrupted) out << YAML::Key << "interrupted" << YAML::Value << true;
   out << YAML::EndMap;
   writeBytesAtomically(dir / "labels.yaml", std::string(out.c_str()) + "\n");
 }
@@ -33,7 +34,9 @@ LabelSetInfo readLabelSetInfo(const std::filesystem::path& dir) {
   const YAML::Node root = loadYamlFile(path);
   const YamlFields f(path);
   f.expectMap(root, "the top level");
-  f.checkKeys(root, "", {"class_map", "frames", "dataset_frames", "cameras", "dataset", "model"});
+  f.checkKeys(
+      root, "",
+      {"class_map", "frames", "dataset_frames", "cameras", "dataset", "model", "interrupted"});
   LabelSetInfo info;
   info.class_map = f.text(root, "", "class_map");
   info.frames = static_cast<size_t>(f.integer(root, "", "frames", 1, 1LL << 40));
@@ -42,6 +45,7 @@ LabelSetInfo readLabelSetInfo(const std::filesystem::path& dir) {
   info.cameras = static_cast<size_t>(f.integer(root, "", "cameras", 1, 64));
   if (root["dataset"]) info.dataset = f.text(root, "", "dataset");
   if (root["model"]) info.model = f.text(root, "", "model");
+  if (root["interrupted"]) info.interrupted = f.flag(root, "", "interrupted");
   return info;
 }
 

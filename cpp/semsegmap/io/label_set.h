@@ -20,6 +20,9 @@ struct LabelSetInfo {
   size_t cameras = 0;   // cameras of its rig
   std::string dataset;  // what it was made from (for people; not checked)
   std::string model;
+  // `semsegmap label` was stopped (Ctrl-C) before labelling the frames it was asked to: the
+  // set is whole for its `frames`, and shorter than asked. Written only when true.
+  bool interrupted = false;
 };
 
 // Writes DIR/labels.yaml atomically: written last, it says that the set is whole.

@@ -82,8 +82,18 @@ SlamFolder readSlamFolder(const std::filesystem::path& dir) {
   const std::string what = "the output of semsegmap slam";
   SlamFolder f;
   f.dir = dir;
-  f.trajectory = readTum(needed(dir, "trajectory_tum.txt", what));
-  if (std::filesystem::exists(dir / "odometry_tum.txt"))
+  // A run over data without frame times writes KITTI files alone (no made-up times): their
+  // line i is frame i of the run, which is all the view needs.
+  const auto poses = [&dir](const std::string& stem) {
+    const std::filesystem::path kitti = dir / (stem + "_kitti.txt");
+    if (std::filesystem::exists(dir / (stem + "_tum.txt")) || !std::filesystem::exists(kitti))
+      return std::vector<StampedPose>{};
+    return readPoseFile(kitti).poses;
+  };
+  f.trajectory = poses("trajectory");
+  if (f.trajectory.empty()) f.trajectory = readTum(needed(dir, "trajectory_tum.txt", what));
+  f.odometry = poses("odometry");
+  if (f.odometry.empty() && std::filesystem::exists(dir / "odometry_tum.txt"))
     f.odometry = readTum(dir / "odometry_tum.txt");
   if (std::filesystem::exists(dir / "loops.csv"))
     f.loops = readLoops(dir / "loops.csv", f.trajectory.size());

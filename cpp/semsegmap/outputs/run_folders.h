@@ -20,7 +20,8 @@ struct LoopRow {  // a line of loops.csv
   double correction_m = 0.0;
 };
 
-// trajectory_tum.txt (loop-closed, one pose per frame), odometry_tum.txt, loops.csv.
+// trajectory_tum.txt (loop-closed, one pose per frame), odometry_tum.txt, loops.csv; from data
+// without frame times, trajectory_kitti.txt and odometry_kitti.txt instead of the TUM files.
 struct SlamFolder {
   std::filesystem::path dir;
   std::vector<StampedPose> trajectory, odometry;

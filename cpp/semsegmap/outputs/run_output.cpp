@@ -85,6 +85,8 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   j["config"] = c.config;
   j["descriptor"] = c.descriptor;
   j["frames"] = run.stats.frames;
+  // Ctrl-C ended the run early: `frames` are those done, every file of them whole.
+  j["interrupted"] = run.stats.interrupted;
   j["distance_m"] = run.distance_m;
   j["has_ground_truth"] = !run.trajectory_gt.empty();
   // The errors below measured against the very poses the local map was built on.
@@ -132,6 +134,7 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
   nlohmann::ordered_json j;
   j["dataset"] = dataset;
   j["frames"] = run.stats.frames;
+  j["interrupted"] = run.stats.interrupted;  // `frames` are those done before Ctrl-C
   j["loop_closures"] = run.loops.size();
   j["map_segments"] = run.map.size();
   j["fps"] = run.stats.fps();
@@ -147,7 +150,7 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset) {
   j["ate_slam_aligned"] = ate(&SlamErrors::slam_aligned);
   j["has_ground_truth"] = errors.has_value();
   j["odometry_is_ground_truth"] = run.odometry_is_ground_truth;
-  // false: the TUM files' times are made up from the rate, not the data's.
+  // false: the data has no frame times, so no TUM file was written (KITTI files alone).
   j["has_frame_times"] = run.has_frame_times;
   return jsonText(j);
 }
@@ -203,16 +206,18 @@ fs::path shownParent(const fs::path& shown, const fs::path& full) {
 
 }  // namespace
 
-RunOutputs::RunOutputs() {
-  setNewFileObserver([this](const fs::path& path) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    written_.push_back(normalized(path));
-  });
-}
+RunOutputs::RunOutputs() = default;
 
 RunOutputs::~RunOutputs() {
-  setNewFileObserver({});
+  watches_.clear();  // first: no write reports to this object once it is being torn down
   if (!committed_) removeCreated();
+}
+
+void RunOutputs::watch(const fs::path& scope) {
+  watches_.push_back(std::make_unique<NewFileWatch>(scope, [this](const fs::path& path) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    written_.push_back(normalized(path));
+  }));
 }
 
 // The folder an output goes into must be there: a mistyped path (`--out /nonexistent/dir/x`)
@@ -243,10 +248,12 @@ size_t RunOutputs::folder(const fs::path& dir, const std::string& what) {
     fs::create_directory(full, ec);
     if (ec) refuse(dir, what, "cannot be created: " + ec.message());
     created_.push_back(full);
+    watch(full);  // claims its files from a RunOutputs whose folder holds it
     return 0;
   }
   requireWritableDirectory(full, dir, what);
   existing_.push_back(full);
+  watch(full);
   size_t listed = 0, entries = 0;
   for (auto it = fs::recursive_directory_iterator(full, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
@@ -267,6 +274,7 @@ bool RunOutputs::file(const fs::path& file, const std::string& what) {
   requireParent(full, file, what);
   if (fs::exists(full, ec)) return true;
   files_.push_back(full);
+  watch(full);
   return false;
 }
 

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/graph/trajectory.h"
 #include "semsegmap/pipeline/modes.h"
@@ -64,7 +66,9 @@ std::string slamSummaryJson(const SlamRun& run, const std::string& dataset);
 // created: the output folders that did not exist, and the files written atomically
 // (core/atomic_file.h) into a folder that did, with the subfolders that held only them. Nothing
 // that existed before is removed (a file the run replaced keeps its new content), so a failed run
-// leaves no summary of its own behind. One RunOutputs at a time per process.
+// leaves no summary of its own behind. Each watches only its own outputs (NewFileWatch, one per
+// declared folder and file), so several may be alive at once, even nested: a file belongs to the
+// one that declared the innermost output holding it.
 class RunOutputs {
  public:
   RunOutputs();
@@ -91,6 +95,8 @@ class RunOutputs {
   // Inside an existing output folder and made by this run.
   bool newFolder(const std::filesystem::path& dir) const;
   void removeCreated() noexcept;
+  // Records the new files written under `scope` (an output folder or file) into written_.
+  void watch(const std::filesystem::path& scope);
 
   std::vector<std::filesystem::path> created_;   // the output folders this run made
   std::vector<std::filesystem::path> existing_;  // declared folders that were there before
@@ -99,6 +105,7 @@ class RunOutputs {
   std::vector<std::filesystem::path> old_dirs_;  // folders inside existing_, before the run
   bool listed_all_ = true;                       // old_dirs_ is complete
   std::mutex mutex_;
+  std::vector<std::unique_ptr<NewFileWatch>> watches_;  // after mutex_: they lock it
   bool committed_ = false;
 };
 

@@ -8,16 +8,27 @@
 
 namespace semsegmap {
 
-namespace {
+namespace {}  // namespace
 
-// Feeds the run's frames (at most options.max_frames) to a mapping or localization session.
-template <typename Session>
-void feed(FrameSource& source, const RunOptions& options, Session& session) {
+// Between frames only: a frame the session started is finished, so what it holds stays whole.
+bool feedFrames(FrameSource& source, const RunOptions& options,
+                const std::function<void(const Frame&)>& process) {
   const size_t n = options.frameCount(source);
   for (size_t i = 0; i < n; ++i) {
-    session.process(source.frame(i));
+    if (options.stop.stopRequested()) return false;
+    process(source.frame(i));
     if (options.progress) options.progress(i + 1, n);
   }
+  return true;
+}
+
+namespace {
+
+// Feeds the run's frames (at most options.max_frames) to a mapping or localization session;
+// whether every frame was fed.
+template <typename Session>
+bool feed(FrameSource& source, const RunOptions& options, Session& session) {
+  return feedFrames(source, options, [&session](const Frame& frame) { session.process(frame); });
 }
 
 // The describer is checked before any of it is read: a constructor's arguments are evaluated in
@@ -154,8 +165,10 @@ MappingRun MappingSession::finish() {
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
                       std::shared_ptr<Describer> describer, const RunOptions& options) {
   MappingSession session(config, source.info(), poses, describer);
-  feed(source, options, session);
-  return session.finish();
+  const bool whole = feed(source, options, session);
+  MappingRun run = session.finish();
+  run.stats.interrupted = !whole;
+  return run;
 }
 
 namespace {
@@ -286,8 +299,10 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
                                 MapSettingsCheck settings) {
   LocalizationSession session(config, source.info(), std::move(map), std::move(describer),
                               settings);
-  feed(source, options, session);
-  return session.take();
+  const bool whole = feed(source, options, session);
+  LocalizationRun run = session.take();
+  run.stats.interrupted = !whole;
+  return run;
 }
 
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {

@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "semsegmap/core/stop_token.h"
 #include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/pipeline.h"
 
@@ -18,13 +19,24 @@ namespace semsegmap {
 struct RunOptions {
   size_t max_frames = 0;                                    // 0: all
   std::function<void(size_t done, size_t total)> progress;  // optional
+  // Checked before each frame: once asked, no further frame starts and the run ends with the
+  // frames done (RunStats::interrupted). The caller's, so Ctrl-C handling stays the program's.
+  StopToken stop;
   // The frames a run reads of `source`: the first max_frames, or all.
   size_t frameCount(const FrameSource& source) const { return framesToRead(source, max_frames); }
 };
 
+// Calls process(frame) on the run's frames in order (at most options.max_frames), with progress
+// after each; options.stop is checked before each, so a frame started is always finished. True
+// when every frame was processed, false when the stop request ended the loop early.
+bool feedFrames(FrameSource& source, const RunOptions& options,
+                const std::function<void(const Frame&)>& process);
+
 struct RunStats {
   size_t frames = 0;
   StageTimes total;  // summed over frames; the pipeline alone, not reading or simulating data
+  // RunOptions::stop ended the run before its last frame: `frames` are the frames done.
+  bool interrupted = false;
   double fps() const { return total.total() > 0 ? 1000.0 * frames / total.total() : 0.0; }
 };
 

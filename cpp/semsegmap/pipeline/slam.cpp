@@ -44,7 +44,8 @@ class SlamSession {
   SlamRun finish() {
     std::vector<Eigen::VectorXf> last;
     const std::vector<Segment> remaining = pipeline_.finish(&last);
-    anchor(nodes() - 1, remaining, last);
+    // No node when a stop request came before the first frame: nothing to anchor to.
+    if (nodes() > 0) anchor(nodes() - 1, remaining, last);
     for (size_t i = 0; i < graph_.size(); ++i) {
       run_.trajectory.push_back({stamps_[i], graph_.pose(i)});
       run_.trajectory_odom.push_back({stamps_[i], odom_[i]});
@@ -172,12 +173,11 @@ class SlamSession {
 SlamRun runSlam(FrameSource& source, const PipelineConfig& config,
                 std::shared_ptr<Describer> describer, const RunOptions& options) {
   SlamSession session(config, source.info(), std::move(describer));
-  const size_t n = options.frameCount(source);
-  for (size_t i = 0; i < n; ++i) {
-    session.process(source.frame(i));
-    if (options.progress) options.progress(i + 1, n);
-  }
-  return session.finish();
+  const bool whole =
+      feedFrames(source, options, [&session](const Frame& frame) { session.process(frame); });
+  SlamRun run = session.finish();
+  run.stats.interrupted = !whole;
+  return run;
 }
 
 }  // namespace semsegmap

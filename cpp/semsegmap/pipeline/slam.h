@@ -31,7 +31,8 @@ struct SlamRun {
   // The odometry was the ground truth itself (DatasetInfo): its error says nothing.
   bool odometry_is_ground_truth = false;
   // The frames' times (the StampedPoses') are the data's; false: made up from the rate
-  // (DatasetInfo::has_frame_times), so that no other file can be matched to them by time.
+  // (DatasetInfo::has_frame_times), so that no file must carry them as times (`semsegmap slam`
+  // then writes no TUM file).
   bool has_frame_times = true;
 };
 
