@@ -1353,10 +1353,9 @@ class CliMaps : public ::testing::Test {
 // `map` without --points keeps the points its configuration asks for, so that a configuration
 // that refines poses (config/lidar-camera.yaml) builds maps its own localization accepts.
 TEST_F(CliMaps, MapKeepsTheConfiguredSegmentPointsUnlessPointsIsGiven) {
-  const std::string refine =
-      eigenConfig(tmp_.path(), "refine.yaml",
-                  "target_map:\n  max_points_per_segment: 8\n"
-                  "localization:\n  refinement:\n    enabled: true\n");
+  const std::string refine = eigenConfig(tmp_.path(), "refine.yaml",
+                                         "target_map:\n  max_points_per_segment: 8\n"
+                                         "localization:\n  refinement:\n    enabled: true\n");
   const std::filesystem::path with = tmp_.path() / "with.map", none = tmp_.path() / "none.map";
   ASSERT_EQ(run("map" + data_ + " --config " + refine + " --out " + with.string()).code, 0);
   const Result uses = localize(refine, with);

@@ -260,8 +260,9 @@ TEST(PipelineConfig, UnknownKeysAndBadValuesNameTheFile) {
 }
 
 // issue 18: a directory given as config said "basic_filebuf::underflow", `localization.k:
-// 1000000000` (now localization.localizer.index.k) "std::bad_alloc" and a value of the wrong type yaml-cpp's "bad conversion". Each now
-// names the file, the key and the value, and every count has limits.
+// 1000000000` (now localization.localizer.index.k) "std::bad_alloc" and a value of the wrong type
+// yaml-cpp's "bad conversion". Each now names the file, the key and the value, and every count has
+// limits.
 TEST(PipelineConfig, CountsValuesAndDirectoriesNameTheFileAndTheKey) {
   const auto dir = std::filesystem::temp_directory_path() /
                    ("semsegmap_test_config_" + std::to_string(::getpid()));

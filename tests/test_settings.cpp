@@ -13,9 +13,9 @@
 #include "error_text.h"
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/core/exact_text.h"
-#include "semsegmap/settings/config.h"
 #include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/setting_table.h"
+#include "semsegmap/settings/config.h"
 #include "temp_dir.h"
 
 namespace semsegmap {

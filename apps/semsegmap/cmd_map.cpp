@@ -93,7 +93,8 @@ const CommandSpec& mapCommand() {
                "poses the map is built with (default: gt when the data has them, else odom)"},
               maxFramesOption(),
               {"points", Value::kCount, "N", "",
-               "points kept per segment, for pictures and pose refinement (localization.refinement), 0..65535 "
+               "points kept per segment, for pictures and pose refinement "
+               "(localization.refinement), 0..65535 "
                "(default: the config's target_map.max_points_per_segment)"},
               {"float32", Value::kFlag, "", "", "store descriptors as float32 instead of float16"},
           }),

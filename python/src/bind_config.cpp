@@ -1,11 +1,11 @@
 // The pipeline configuration (pipeline/pipeline_config.h and the stages' config structs) and its
-// YAML reader (settings/config.h). Fields are named as in the C++ structs, and a setting's YAML key is
-// its attribute path (pipeline/setting_table.h; python/tests/test_config.py holds the fields
+// YAML reader (settings/config.h). Fields are named as in the C++ structs, and a setting's YAML key
+// is its attribute path (pipeline/setting_table.h; python/tests/test_config.py holds the fields
 // bound here to the table: localization.localizer.index.k is c.localization.localizer.index.k).
 #include "bindings.h"
-#include "semsegmap/settings/config.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 #include "semsegmap/pipeline/setting_table.h"
+#include "semsegmap/settings/config.h"
 
 namespace semsegmap::python {
 

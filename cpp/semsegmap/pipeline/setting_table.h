@@ -1,7 +1,7 @@
 // Every setting of a config file, declared once: its key, which is its member path in the config
 // structs (and its attribute path in Python), its type and limits, whether a target map records
-// it, and what it does. settings/config.cpp reads YAML through this table, map_parameters.cpp records
-// and compares maps through it, and the tests hold the Python binding and its stubs to it.
+// it, and what it does. settings/config.cpp reads YAML through this table, map_parameters.cpp
+// records and compares maps through it, and the tests hold the Python binding and its stubs to it.
 //
 // The YAML nests as the structs do (`localization: {localizer: {index: {k: 16}}}`) rather than
 // the structs being flattened for shorter keys: each nested struct is a stage's own config
