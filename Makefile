@@ -32,9 +32,13 @@ bench: build
 # build-fuzz/, then each run for FUZZ_SECONDS from seeds the build generates. Skipped, saying
 # why, when clang or its fuzzer runtime is missing.
 FUZZ_SECONDS ?= 4
+# FUZZ_TORCH=OFF (CI) builds without libtorch: the model-file harness then fuzzes the file
+# format alone, not the network built from it.
+FUZZ_TORCH ?= ON
 FUZZ_CMAKE_FLAGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DSEMSEGMAP_FUZZ=ON -DSEMSEGMAP_WITH_SIM=OFF -DSEMSEGMAP_WITH_PYTHON=OFF \
-  -DSEMSEGMAP_WITH_VIEWER=OFF -DSEMSEGMAP_BUILD_TESTS=OFF -DSEMSEGMAP_BUILD_BENCH=OFF
+  -DSEMSEGMAP_WITH_VIEWER=OFF -DSEMSEGMAP_BUILD_TESTS=OFF -DSEMSEGMAP_BUILD_BENCH=OFF \
+  -DSEMSEGMAP_WITH_TORCH=$(FUZZ_TORCH)
 fuzz: setup
 	@if ! command -v clang++ > /dev/null; then \
 	  echo "fuzz: skipped: clang++ is missing (scripts/setup.sh installs clang)"; \

@@ -7,9 +7,11 @@
 #include <fstream>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/datasets/semantic_sources.h"
 #include "semsegmap/io/image_io.h"
 #include "semsegmap/io/label_set.h"
+#include "semsegmap/pipeline/pipeline.h"
 #include "semsegmap/semantics/frame_labeler.h"
 #include "semsegmap/settings/class_map_file.h"
 #include "semsegmap/settings/config.h"
@@ -383,6 +385,45 @@ TEST(SemanticSources, TheNetworkIsCheckedOnEveryCameraBeforeAnyFrame) {
   fixed.model = "/nonexistent.onnx";
   EXPECT_TRUE(throwsWith([&] { loadSegmentationNetwork(fixed, memory.info(), kClassMaps); },
                          {"/nonexistent.onnx"}));
+}
+
+// The network and LiDAR odometry as stages of the pipeline (what code that embeds it gets) give
+// what the frame source that wraps them gives the command line's experiments: the same labels,
+// the same poses, the same segments; the caller's frame is left as it was.
+TEST(FrontEndStages, APipelineLabelsAndRegistersItsFramesAsAWrappedSourceDoes) {
+#if !SEMSEGMAP_WITH_SIM
+  GTEST_SKIP() << "needs the simulator (SEMSEGMAP_WITH_SIM=ON)";
+#endif
+  DatasetOptions options;
+  options.odometry = "lidar";
+  options.semantics = plainConfig();
+  options.semantics.class_map = (kClassMaps / "cityscapes.yaml").string();
+  options.semantics.replace_dataset_labels = true;  // the simulator's frames come with labels
+  options.class_maps_dir = kClassMaps;
+  const std::string spec = "sim:world=1,run=S1,preset=tiny,frames=6";
+  auto wrapped = openDataset(spec, options);
+  DatasetWithStages own = openDatasetForPipeline(spec, options);
+  ASSERT_TRUE(own.stages.network && own.stages.lidar_odometry);
+  const PipelineConfig config;
+  Pipeline by_source(config, wrapped->info(), PoseSource::kOdometry);
+  Pipeline by_stages(config, own.source->info(), PoseSource::kOdometry, nullptr, own.stages);
+  size_t relabelled = 0;
+  for (size_t i = 0; i < wrapped->size(); ++i) {
+    const Frame a = wrapped->frame(i), b = own.source->frame(i);
+    const FrameResult ra = by_source.process(a), rb = by_stages.process(b);
+    EXPECT_EQ(ra.T_local_base.matrix(), rb.T_local_base.matrix()) << "frame " << i;
+    EXPECT_EQ(ra.colored_points, rb.colored_points);
+    EXPECT_EQ(ra.segmentation.observed, rb.segmentation.observed);
+    const Frame& labelled = by_stages.processedFrame(b);
+    for (size_t k = 0; k < a.cameras.size(); ++k) {
+      EXPECT_EQ(labelled.cameras[k].label.data, a.cameras[k].label.data) << i << " camera " << k;
+      relabelled += b.cameras[k].label.data != labelled.cameras[k].label.data;
+    }
+  }
+  EXPECT_GT(relabelled, 0u) << "the caller's frames kept the simulator's labels";
+  ASSERT_NE(by_stages.labeling(), nullptr);
+  EXPECT_EQ(by_stages.labeling()->network_runs,
+            wrapped->size() * wrapped->info().rig.cameras.size());
 }
 
 TEST(SemanticsConfig, ReadFromTheConfigRelativeToIt) {

@@ -60,7 +60,9 @@ int runLocalize(const CliArgs& a) {
     throw std::runtime_error(map_path.string() + ": map built with " + map->descriptor +
                              " descriptors, the configuration uses " + kind);
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
-  auto source = openDatasetArg(a);
+  // The network and LiDAR odometry, when asked for, run inside the pipeline.
+  DatasetWithStages data = openDatasetForPipelineArg(a);
+  std::unique_ptr<FrameSource>& source = data.source;
   std::shared_ptr<Describer> describer = describerFor(config.descriptor, *source);
   checkMapCompatible(map_path, *map, descriptorName(describer->kind()), describer->fingerprint(),
                      describer->dimension());
@@ -70,6 +72,7 @@ int runLocalize(const CliArgs& a) {
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   options.stop = stopToken();
+  options.stages = data.stages;
   const LocalizationRun run = runLocalization(*source, config, map, describer, options, settings);
   // Stopped before its first frame: nothing worth writing (main removes what the run made).
   if (run.stats.interrupted && run.stats.frames == 0)

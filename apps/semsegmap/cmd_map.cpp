@@ -28,7 +28,9 @@ int runMap(const CliArgs& a) {
   }
   const std::filesystem::path out = a.get("out");
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
-  auto source = openDatasetArg(a);
+  // The network and LiDAR odometry, when asked for, run inside the pipeline.
+  DatasetWithStages data = openDatasetForPipelineArg(a);
+  std::unique_ptr<FrameSource>& source = data.source;
   // The model before any frame: a missing one, or a descriptor this build has not, fails first.
   std::shared_ptr<Describer> describer = describerFor(config.descriptor, *source);
   const std::string poses = a.has("poses")                          ? a.get("poses")
@@ -41,6 +43,7 @@ int runMap(const CliArgs& a) {
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   // The map of the frames done is whole and usable: saved as any other.
   options.stop = stopToken();
+  options.stages = data.stages;
   TargetMap map;
   RunStats stats;
   size_t segments = 0, earlier = 0, duplicates = 0;

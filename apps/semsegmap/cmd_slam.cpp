@@ -45,7 +45,9 @@ int runSlamCommand(const CliArgs& a) {
   const PipelineConfig config = loadPipelineConfig(a.get("config"));
   const std::filesystem::path out = a.get("out");
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
-  auto source = openDatasetArg(a);
+  // The network and LiDAR odometry, when asked for, run inside the pipeline.
+  DatasetWithStages data = openDatasetForPipelineArg(a);
+  std::unique_ptr<FrameSource>& source = data.source;
   std::shared_ptr<Describer> describer = describerFor(config.descriptor, *source);
 
   Progress progress("slam", 0);
@@ -53,6 +55,7 @@ int runSlamCommand(const CliArgs& a) {
   options.max_frames = a.frameLimit();
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   options.stop = stopToken();
+  options.stages = data.stages;
   const SlamRun run = runSlam(*source, config, describer, options);
   // Stopped before its first frame: nothing worth writing (main removes what the run made).
   if (run.stats.interrupted && run.stats.frames == 0)

@@ -37,7 +37,9 @@ std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<Opti
   return options;
 }
 
-std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesystem::path& config) {
+namespace {
+
+DatasetOptions datasetOptionsOf(const CliArgs& a, const std::filesystem::path& config) {
   DatasetOptions options;
   if (a.has("rig")) options.rig = a.get("rig");
   const auto& declared = a.command().options;
@@ -60,7 +62,17 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesys
   if (a.has("kitti-calib")) options.kitti_calib = a.get("kitti-calib");
   // Only the frames the run reads are checked up front: --max-frames 1 on a long recording.
   if (declares("max-frames")) options.frames_to_check = a.frameLimit();
-  return openDataset(a.get("dataset"), options);
+  return options;
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesystem::path& config) {
+  return openDataset(a.get("dataset"), datasetOptionsOf(a, config));
+}
+
+DatasetWithStages openDatasetForPipelineArg(const CliArgs& a) {
+  return openDatasetForPipeline(a.get("dataset"), datasetOptionsOf(a, {}));
 }
 
 std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,

@@ -9,6 +9,7 @@
 
 #include "cli_args.h"
 #include "semsegmap/core/frame_source.h"
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
@@ -26,6 +27,10 @@ std::vector<OptionSpec> datasetOptions(const std::string& help, std::vector<Opti
 // that take several (eval revisits); by default the command's --config.
 std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a,
                                             const std::filesystem::path& config = {});
+// The same for a command that runs one Pipeline (map, localize, slam): the network and LiDAR
+// odometry come as stages for the pipeline to own (pipeline/front_end_stages.h), as they do for
+// code that embeds it.
+DatasetWithStages openDatasetForPipelineArg(const CliArgs& a);
 
 // The describer for the data `source` gives: descriptor.model, or descriptor.model_lidar_only
 // for a LiDAR without a camera (chooseDescriptor); what was chosen or assumed is printed.

@@ -32,10 +32,9 @@ using Path = std::filesystem::path;
 
 // The command line's --rig, --odometry, --ground-truth, --kitti-calib and --labels, and the
 // --config whose odometry: and semantics: sections apply.
-std::shared_ptr<FrameSource> open(const std::string& spec, const Path& rig, const Path& odometry,
-                                  const Path& ground_truth, const Path& kitti_calib,
-                                  const Path& labels, const Path& config,
-                                  const Path& class_maps_dir) {
+DatasetOptions optionsOf(const Path& rig, const Path& odometry, const Path& ground_truth,
+                         const Path& kitti_calib, const Path& labels, const Path& config,
+                         const Path& class_maps_dir) {
   DatasetOptions options;
   options.rig = rig;
   options.odometry = odometry;
@@ -47,8 +46,42 @@ std::shared_ptr<FrameSource> open(const std::string& spec, const Path& rig, cons
     options.class_maps_dir = class_maps_dir.empty() ? shippedClassMaps() : class_maps_dir;
   options.ground_truth = ground_truth;
   options.kitti_calib = kitti_calib;
+  return options;
+}
+
+std::shared_ptr<FrameSource> open(const std::string& spec, const Path& rig, const Path& odometry,
+                                  const Path& ground_truth, const Path& kitti_calib,
+                                  const Path& labels, const Path& config,
+                                  const Path& class_maps_dir) {
+  const DatasetOptions options =
+      optionsOf(rig, odometry, ground_truth, kitti_calib, labels, config, class_maps_dir);
   py::gil_scoped_release release;
   return openDataset(spec, options);
+}
+
+std::pair<std::shared_ptr<FrameSource>, FrontEndStages> openForPipeline(
+    const std::string& spec, const Path& rig, const Path& odometry, const Path& ground_truth,
+    const Path& kitti_calib, const Path& labels, const Path& config, const Path& class_maps_dir) {
+  const DatasetOptions options =
+      optionsOf(rig, odometry, ground_truth, kitti_calib, labels, config, class_maps_dir);
+  py::gil_scoped_release release;
+  DatasetWithStages d = openDatasetForPipeline(spec, options);
+  return {std::shared_ptr<FrameSource>(std::move(d.source)), std::move(d.stages)};
+}
+
+void bindFrontEndStages(py::module_& m) {
+  py::class_<FrontEndStages> stages(
+      m, "FrontEndStages",
+      "The network and LiDAR odometry a Pipeline runs on each frame before enrichment "
+      "(pipeline/front_end_stages.h); from open_dataset_for_pipeline");
+  defRepr(stages, "FrontEndStages", {"network", "lidar_odometry"});
+  stages.def(py::init<>(), "No stage: the frames' own labels and odometry")
+      .def_property_readonly(
+          "network", [](const FrontEndStages& s) { return s.network != nullptr; },
+          "whether the semantics: network labels pictures without label images")
+      .def_property_readonly(
+          "lidar_odometry", [](const FrontEndStages& s) { return s.lidar_odometry.has_value(); },
+          "whether LiDAR odometry gives each frame's pose");
 }
 
 }  // namespace
@@ -92,6 +125,13 @@ void bindDatasets(py::module_& m) {
         return readFrame(*it.source, it.next++);
       });
 
+  bindFrontEndStages(m);
+  m.def("open_dataset_for_pipeline", &openForPipeline, py::arg("spec"), py::kw_only(),
+        py::arg("rig") = "", py::arg("odometry") = "", py::arg("ground_truth") = "",
+        py::arg("kitti_calib") = "", py::arg("labels") = "", py::arg("config") = "",
+        py::arg("class_maps_dir") = "",
+        "open_dataset for a Pipeline or session that runs the network and LiDAR odometry "
+        "itself: (the dataset without them, FrontEndStages to give as stages=)");
   m.def("open_dataset", &open, py::arg("spec"), py::kw_only(), py::arg("rig") = "",
         py::arg("odometry") = "", py::arg("ground_truth") = "", py::arg("kitti_calib") = "",
         py::arg("labels") = "", py::arg("config") = "", py::arg("class_maps_dir") = "",

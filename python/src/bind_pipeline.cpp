@@ -42,6 +42,11 @@ MapSettingsCheck settingsCheck(bool allow_config_mismatch) {
 }
 
 // The command line's default: ground truth when the dataset has it, else odometry.
+// The front-end stages a Python caller gave (open_dataset_for_pipeline), or none.
+FrontEndStages stagesOf(const py::object& stages) {
+  return stages.is_none() ? FrontEndStages{} : stages.cast<FrontEndStages>();
+}
+
 PoseSource posesFor(const py::object& poses, const DatasetInfo& info) {
   if (poses.is_none())
     return info.has_ground_truth_poses ? PoseSource::kGroundTruth : PoseSource::kOdometry;
@@ -178,13 +183,16 @@ void bindPipelineClass(py::module_& m) {
   py::class_<Pipeline>(m, "Pipeline",
                        "The front end frame by frame: enrich, local map, segment, describe")
       .def(py::init([](const PipelineConfig& c, const DatasetInfo& info, const py::object& poses,
-                       std::shared_ptr<Describer> d) {
-             return std::make_unique<Pipeline>(c, info, posesFor(poses, info), std::move(d));
+                       std::shared_ptr<Describer> d, const py::object& stages) {
+             const FrontEndStages s = stagesOf(stages);
+             return std::make_unique<Pipeline>(c, info, posesFor(poses, infoWithStages(info, s)),
+                                               std::move(d), s);
            }),
            py::arg("config"), py::arg("info"), py::arg("poses") = py::none(),
-           py::arg("describer") = nullptr,
+           py::arg("describer") = nullptr, py::arg("stages") = py::none(),
            "poses: 'gt' or 'odom' (default: gt when the dataset has it); no describer: segments "
-           "are not described")
+           "are not described; stages (FrontEndStages, from open_dataset_for_pipeline): the "
+           "network and LiDAR odometry run on each frame before enrichment")
       .def(
           "process",
           [](Pipeline& p, const Frame& f) {
@@ -234,11 +242,15 @@ void bindMapping(py::module_& m) {
       .def_readonly("stats", &MappingResult::stats);
   py::class_<MappingSession>(m, "MappingSession", "Builds a target map frame by frame")
       .def(py::init([](const PipelineConfig& c, const DatasetInfo& info,
-                       std::shared_ptr<Describer> d, const py::object& poses) {
-             return std::make_unique<MappingSession>(c, info, posesFor(poses, info),
-                                                     required(std::move(d), "MappingSession"));
+                       std::shared_ptr<Describer> d, const py::object& poses,
+                       const py::object& stages) {
+             const FrontEndStages s = stagesOf(stages);
+             return std::make_unique<MappingSession>(c, info,
+                                                     posesFor(poses, infoWithStages(info, s)),
+                                                     required(std::move(d), "MappingSession"), s);
            }),
-           py::arg("config"), py::arg("info"), py::arg("describer"), py::arg("poses") = py::none())
+           py::arg("config"), py::arg("info"), py::arg("describer"), py::arg("poses") = py::none(),
+           py::arg("stages") = py::none())
       .def(
           "process",
           [](MappingSession& s, const Frame& f) {
@@ -371,15 +383,16 @@ void bindLocalization(py::module_& m) {
                                   "Localizes a run frame by frame, on its odometry")
       .def(py::init([](const PipelineConfig& c, const DatasetInfo& info,
                        std::shared_ptr<TargetMap> map, std::shared_ptr<Describer> d,
-                       bool allow_config_mismatch) {
+                       bool allow_config_mismatch, const py::object& stages) {
              d = required(std::move(d), "LocalizationSession");
+             const FrontEndStages s = stagesOf(stages);
              py::gil_scoped_release release;  // builds the map's descriptor index
              return std::make_unique<LocalizationSession>(
                  c, info, std::shared_ptr<const TargetMap>(std::move(map)), std::move(d),
-                 settingsCheck(allow_config_mismatch));
+                 settingsCheck(allow_config_mismatch), s);
            }),
            py::arg("config"), py::arg("info"), py::arg("map"), py::arg("describer"),
-           py::arg("allow_config_mismatch") = false,
+           py::arg("allow_config_mismatch") = false, py::arg("stages") = py::none(),
            "RuntimeError when the map's descriptors are not the describer's, or when the map "
            "was built with other settings than `config` (unless allow_config_mismatch: then "
            "a warning on stderr for each)")

@@ -207,7 +207,11 @@ std::unique_ptr<FrameSource> openSource(const std::string& spec, const DatasetOp
 
 }  // namespace
 
-std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetOptions& options) {
+namespace {
+
+// The dataset as read, with its pose files, label set and rig checked; without the stages a
+// pipeline may own (LiDAR odometry, the network).
+std::unique_ptr<FrameSource> openRead(const std::string& spec, const DatasetOptions& options) {
   auto source = openSource(spec, options);
   if (!options.rig.empty() && dynamic_cast<FolderReader*>(source.get()) == nullptr)
     throw std::invalid_argument(optionText("rig", "FILE") + ": dataset '" + spec +
@@ -218,17 +222,34 @@ std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetO
   poses.ground_truth = options.ground_truth;
   poses.kitti_calib = options.kitti_calib;
   source = withPoseFiles(std::move(source), poses);
-  if (lidar_odometry) source = withLidarOdometry(std::move(source), options.lidar_odometry);
-  if (source->info().odometry_is_ground_truth)
+  if (!lidar_odometry && source->info().odometry_is_ground_truth)
     note(source->info().name + ": its ground-truth poses serve as its odometry too (" +
          optionText("odometry", "FILE") + " or " + optionText("odometry", "lidar", true) +
          " for odometry of its own): errors measured against them are marked so");
   if (!options.labels.empty())
     source = withLabelSet(std::move(source), options.labels, options.class_maps_dir,
                           options.frames_to_check);
-  if (options.semantics.model.empty()) return source;
-  auto network = loadSegmentationNetwork(options.semantics, source->info(), options.class_maps_dir);
-  return withSegmentationNetwork(std::move(source), std::move(network));
+  return source;
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> openDataset(const std::string& spec, const DatasetOptions& options) {
+  DatasetWithStages d = openDatasetForPipeline(spec, options);
+  if (d.stages.lidar_odometry)
+    d.source = withLidarOdometry(std::move(d.source), *d.stages.lidar_odometry);
+  if (!d.stages.network) return std::move(d.source);
+  return withSegmentationNetwork(std::move(d.source), std::move(d.stages.network));
+}
+
+DatasetWithStages openDatasetForPipeline(const std::string& spec, const DatasetOptions& options) {
+  DatasetWithStages d;
+  d.source = openRead(spec, options);
+  if (options.odometry == "lidar") d.stages.lidar_odometry = options.lidar_odometry;
+  if (!options.semantics.model.empty())
+    d.stages.network =
+        loadSegmentationNetwork(options.semantics, d.source->info(), options.class_maps_dir);
+  return d;
 }
 
 }  // namespace semsegmap

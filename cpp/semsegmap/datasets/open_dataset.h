@@ -22,6 +22,7 @@
 
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/odometry/lidar_odometry.h"
+#include "semsegmap/pipeline/front_end_stages.h"
 #include "semsegmap/semantics/segmentation_network.h"
 
 namespace semsegmap {
@@ -48,6 +49,16 @@ struct DatasetOptions {
 // network (semantics.model) is loaded and checked against the rig's cameras here, before any
 // frame is read; it is the outermost step, so that odometry never waits for it.
 std::unique_ptr<FrameSource> openDataset(const std::string& spec,
+                                         const DatasetOptions& options = {});
+
+// The same dataset for a Pipeline that runs the network and LiDAR odometry itself
+// (pipeline/front_end_stages.h): the source without them, and the stages the options ask for,
+// the network loaded and checked against the rig's cameras as openDataset does.
+struct DatasetWithStages {
+  std::unique_ptr<FrameSource> source;
+  FrontEndStages stages;
+};
+DatasetWithStages openDatasetForPipeline(const std::string& spec,
                                          const DatasetOptions& options = {});
 
 }  // namespace semsegmap

@@ -54,9 +54,10 @@ MapSegment mapSegmentOf(const Segment& s, size_t points) {
 }  // namespace
 
 MappingSession::MappingSession(const PipelineConfig& config, const DatasetInfo& info,
-                               PoseSource poses, std::shared_ptr<Describer> describer)
+                               PoseSource poses, std::shared_ptr<Describer> describer,
+                               const FrontEndStages& stages)
     : config_(config),
-      pipeline_(config, info, poses, describer),
+      pipeline_(config, info, poses, describer, stages),
       builder_(builderFor(requireDescriber(describer, "MappingSession"), config.target_map)) {
   builder_.setParameters(mapParametersOf(config));
 }
@@ -164,7 +165,7 @@ MappingRun MappingSession::finish() {
 
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
                       std::shared_ptr<Describer> describer, const RunOptions& options) {
-  MappingSession session(config, source.info(), poses, describer);
+  MappingSession session(config, source.info(), poses, describer, options.stages);
   const bool whole = feed(source, options, session);
   MappingRun run = session.finish();
   run.stats.interrupted = !whole;
@@ -192,15 +193,15 @@ std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map
 LocalizationSession::LocalizationSession(const PipelineConfig& config, const DatasetInfo& info,
                                          std::shared_ptr<const TargetMap> map,
                                          std::shared_ptr<Describer> describer,
-                                         MapSettingsCheck settings)
+                                         MapSettingsCheck settings, const FrontEndStages& stages)
     : config_(config),
-      info_(info),
+      info_(infoWithStages(info, stages)),
       describer_(describer),
       localizer_(checkedMap(std::move(map), requireDescriber(describer, "LocalizationSession"),
                             config, settings),
                  config.localization.localizer),
-      pipeline_(config, info, PoseSource::kOdometry, describer) {
-  run_.odometry_is_ground_truth = info.odometry_is_ground_truth;
+      pipeline_(config, info, PoseSource::kOdometry, describer, stages) {
+  run_.odometry_is_ground_truth = info_.odometry_is_ground_truth;
 }
 
 void LocalizationSession::process(const Frame& frame) {
@@ -222,8 +223,8 @@ void LocalizationSession::process(const Frame& frame) {
     const bool latest_scan = !a.found && fallback_m > 0 && moved >= fallback_m;
     if (a.found)
       T_map_base = a.found->T_map_local * r.T_local_base;
-    else if (latest_scan)
-      a = attemptLatestScan(frame, T_map_base);
+    else if (latest_scan)  // the scan as the front-end stages left it: labelled and posed
+      a = attemptLatestScan(pipeline_.processedFrame(frame), T_map_base);
     r.times.localize_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (a.found) record(frame, T_map_base, a, latest_scan);
@@ -297,8 +298,8 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
                                 std::shared_ptr<const TargetMap> map,
                                 std::shared_ptr<Describer> describer, const RunOptions& options,
                                 MapSettingsCheck settings) {
-  LocalizationSession session(config, source.info(), std::move(map), std::move(describer),
-                              settings);
+  LocalizationSession session(config, source.info(), std::move(map), std::move(describer), settings,
+                              options.stages);
   const bool whole = feed(source, options, session);
   LocalizationRun run = session.take();
   run.stats.interrupted = !whole;

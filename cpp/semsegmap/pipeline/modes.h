@@ -22,6 +22,8 @@ struct RunOptions {
   // Checked before each frame: once asked, no further frame starts and the run ends with the
   // frames done (RunStats::interrupted). The caller's, so Ctrl-C handling stays the program's.
   StopToken stop;
+  // Run on every frame before enrichment: the network, LiDAR odometry (front_end_stages.h).
+  FrontEndStages stages;
   // The frames a run reads of `source`: the first max_frames, or all.
   size_t frameCount(const FrameSource& source) const { return framesToRead(source, max_frames); }
 };
@@ -55,7 +57,7 @@ struct MappingRun {
 class MappingSession {
  public:
   MappingSession(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
-                 std::shared_ptr<Describer> describer);
+                 std::shared_ptr<Describer> describer, const FrontEndStages& stages = {});
   void process(const Frame& frame);
   MappingRun finish();  // once, after the last frame
   // The segments whose earlier observations the session holds until they finish
@@ -129,7 +131,8 @@ class LocalizationSession {
  public:
   LocalizationSession(const PipelineConfig& config, const DatasetInfo& info,
                       std::shared_ptr<const TargetMap> map, std::shared_ptr<Describer> describer,
-                      MapSettingsCheck settings = MapSettingsCheck::kRefuse);
+                      MapSettingsCheck settings = MapSettingsCheck::kRefuse,
+                      const FrontEndStages& stages = {});
   void process(const Frame& frame);
   const LocalizationRun& run() const { return run_; }
   LocalizationRun take() { return std::move(run_); }

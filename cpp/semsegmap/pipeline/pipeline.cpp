@@ -32,16 +32,17 @@ PoseSource parsePoseSource(const std::string& name) {
 }
 
 Pipeline::Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
-                   std::shared_ptr<Describer> describer)
+                   std::shared_ptr<Describer> describer, const FrontEndStages& stages)
     : config_(config),
-      info_(info),
+      info_(infoWithStages(info, stages)),
       poses_(poses),
+      preparation_(stages, info),
       local_map_(config.local_map, info.classes),
       segmenter_(config.segmentation),
       describer_(std::move(describer)) {
   // Refused up front: without odometry every T_odom_base is the identity, and a run on them
   // would stack all scans in one place and still exit 0.
-  if (poses == PoseSource::kOdometry && !info.has_odometry)
+  if (poses == PoseSource::kOdometry && !info_.has_odometry)
     throw std::runtime_error(
         "dataset " + info.name + " has no odometry: give " + optionText("odometry", "FILE") +
         " (TUM or KITTI poses) or " + optionText("odometry", "lidar", true) +
@@ -141,7 +142,8 @@ void Pipeline::checkCameraCoverage(const LocalMapUpdate& update, size_t points, 
     warn(seen + ": the semantic part of the segmentation and the descriptor is nearly off");
 }
 
-FrameResult Pipeline::process(const Frame& frame) {
+FrameResult Pipeline::process(const Frame& given) {
+  const Frame& frame = preparation_.prepare(given);
   FrameResult r;
   r.frame_index = frame.index;
   if (poses_ == PoseSource::kGroundTruth) {

@@ -13,6 +13,7 @@
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/localize/localizer.h"
+#include "semsegmap/pipeline/front_end_stages.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 #include "semsegmap/segment/incremental_segmenter.h"
 
@@ -62,12 +63,18 @@ struct LocalSegmentQuery {
 class Pipeline {
  public:
   // `describer` (optional; shared, e.g. by several runs of one experiment, but used by one
-  // pipeline at a time) turns segment observations into descriptors.
+  // pipeline at a time) turns segment observations into descriptors. `stages` (optional) label
+  // and register each frame before enrichment (pipeline/front_end_stages.h).
   Pipeline(const PipelineConfig& config, const DatasetInfo& info, PoseSource poses,
-           std::shared_ptr<Describer> describer = nullptr);
+           std::shared_ptr<Describer> describer = nullptr, const FrontEndStages& stages = {});
 
   // Throws when the frame lacks the pose asked for (ground truth on a dataset without it).
   FrameResult process(const Frame& frame);
+  // The frame the last process() worked on, given the frame passed to it: that frame itself, or
+  // with front-end stages its labelled and registered copy.
+  const Frame& processedFrame(const Frame& given) const { return preparation_.last(given); }
+  // How often the front end's network ran; nullptr without one.
+  const LabelingStats* labeling() const { return preparation_.labeling(); }
   // End of the run: every segment still in the local map, finished; `descriptors` (optional)
   // receives their final descriptors when a describer is set.
   std::vector<Segment> finish(std::vector<Eigen::VectorXf>* descriptors = nullptr);
@@ -93,6 +100,7 @@ class Pipeline {
   PipelineConfig config_;
   DatasetInfo info_;
   PoseSource poses_;
+  FramePreparation preparation_;
   LocalMap local_map_;
   IncrementalSegmenter segmenter_;
   std::shared_ptr<Describer> describer_;

@@ -16,13 +16,14 @@ namespace {
 // with the current node estimates; only an optimization moves the segments already in it.
 class SlamSession {
  public:
-  SlamSession(const PipelineConfig& config, const DatasetInfo& info,
-              std::shared_ptr<Describer> describer)
+  SlamSession(const PipelineConfig& config, const DatasetInfo& given,
+              std::shared_ptr<Describer> describer, const FrontEndStages& stages)
       : config_(config),
         graph_(config.loop_closure.graph),
-        pipeline_(config, info, PoseSource::kOdometry, describer),
+        pipeline_(config, given, PoseSource::kOdometry, describer, stages),
         localizer_(emptyMap(requireDescriber(describer, "SlamSession")),
                    config.localization.localizer) {
+    const DatasetInfo info = infoWithStages(given, stages);
     run_.odometry_is_ground_truth = info.odometry_is_ground_truth;
     run_.has_frame_times = info.has_frame_times;
   }
@@ -172,7 +173,7 @@ class SlamSession {
 
 SlamRun runSlam(FrameSource& source, const PipelineConfig& config,
                 std::shared_ptr<Describer> describer, const RunOptions& options) {
-  SlamSession session(config, source.info(), std::move(describer));
+  SlamSession session(config, source.info(), std::move(describer), options.stages);
   const bool whole =
       feedFrames(source, options, [&session](const Frame& frame) { session.process(frame); });
   SlamRun run = session.finish();
