@@ -1,6 +1,7 @@
 // The layer rule of docs/architecture.md, checked on the sources: every folder of the library
-// includes only from the folders below it. In particular the stages never include io/ (file
-// formats) or sim/ (the simulator): they take and return plain values.
+// includes only from the folders below it. In particular the stages never include a file folder
+// (io/, settings/, artefacts/, outputs/) or sim/ (the simulator): they take and return plain
+// values.
 #include <gtest/gtest.h>
 
 #include <filesystem>
