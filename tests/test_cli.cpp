@@ -307,6 +307,34 @@ TEST(Cli, HelpShowsDefaultsAndRequiredOptions) {
   }
 }
 
+// An option whose help says its default in words ("(default: shipped)") gets no second one from
+// the help generator: `eval paper --help` used to show both for --configs and --config.
+TEST(Cli, HelpSaysEachDefaultOnce) {
+  for (const CommandOptions& c : kCommands) {
+    SCOPED_TRACE(c.command);
+    // An option's entry: its "  --name" line and the wrapped lines under it.
+    std::vector<std::string> entries;
+    std::istringstream in(help(c.command).out);
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("  --", 0) == 0)
+        entries.push_back(line);
+      else if (!entries.empty() && line.rfind("      ", 0) == 0)
+        entries.back() += line;
+    }
+    for (const std::string& entry : entries) {
+      const size_t first = entry.find("(default: ");
+      EXPECT_EQ(entry.find("(default: ", first == std::string::npos ? first : first + 1),
+                std::string::npos)
+          << entry;
+    }
+  }
+  if (built("eval paper")) {
+    const std::string paper = help("eval paper").out;
+    EXPECT_NE(paper.find("(default: the shipped ones)"), std::string::npos) << paper;
+    EXPECT_EQ(paper.find("(default: config/semsegmap.yaml"), std::string::npos) << paper;
+  }
+}
+
 // Every option a help lists is accepted by the parser: given all of them (a value each) and then
 // an unknown one, the only complaint is about the unknown one.
 TEST(Cli, ParserAcceptsWhatTheHelpLists) {
@@ -915,15 +943,22 @@ std::vector<std::string> csvLine(const std::filesystem::path& file, size_t n) {
   return fields;
 }
 
+// A copy of the simulated dataset in DIR/data without its scan `left_out`, and DIR/odom.txt, the
+// odometry of all its frames as a KITTI file. Returns the copy.
+std::filesystem::path scansWithout(const std::filesystem::path& dir, const std::string& left_out) {
+  const std::filesystem::path data = copyOfDataset(dir / "data");
+  std::filesystem::remove(data / "lidar" / left_out);
+  std::ofstream(dir / "odom.txt") << poseFilesOf(data, "odom_").kitti;
+  return data;
+}
+
 // Scans named by frame number (000001.bin left out), odometry from a KITTI file, no ground truth
 // and no times: what is unknown is null or empty, never 0 or made up, frames are named as the
 // dataset names them, and the summary line says no "<1 m".
 TEST(CliPoseFiles, WithoutGroundTruthOrTimesNothingIsMadeUp) {
   if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
   TempDir tmp;
-  const std::filesystem::path data = copyOfDataset(tmp.path() / "data"), dir = tmp.path();
-  std::filesystem::remove(data / "lidar" / "000001.bin");
-  std::ofstream(dir / "odom.txt") << poseFilesOf(data, "odom_").kitti;
+  const std::filesystem::path dir = tmp.path(), data = scansWithout(dir, "000001.bin");
   const std::string config = " --config " + eigenConfig(dir, "eigen.yaml");
   const std::string scans = " --dataset folder:" + (data / "lidar").string() + " --odometry " +
                             (dir / "odom.txt").string();
@@ -986,6 +1021,79 @@ TEST(CliPoseFiles, WithoutFrameTimesNoTumFileIsWritten) {
   ASSERT_EQ(timed.code, 0) << timed.err;
   EXPECT_EQ(lines(readFile(dir / "timed" / "trajectory_tum.txt")), 3u);
   EXPECT_EQ(timed.err.find("no trajectory_tum.txt"), std::string::npos) << timed.err;
+}
+
+// The header and row `n` (from 1) of a trajectory.csv, the fields a test looks at: frame,
+// dataset_frame, timestamp.
+void expectFrameNames(const std::filesystem::path& csv, size_t n, const std::string& frame,
+                      const std::string& dataset_frame, const std::string& timestamp) {
+  SCOPED_TRACE(csv.string() + " row " + std::to_string(n));
+  const std::vector<std::string> header = csvLine(csv, 0), row = csvLine(csv, n);
+  ASSERT_GE(header.size(), 3u);
+  EXPECT_EQ(header[0], "frame");
+  EXPECT_EQ(header[1], "dataset_frame");
+  EXPECT_EQ(header[2], "timestamp");
+  ASSERT_EQ(row.size(), header.size());
+  EXPECT_EQ(row[0], frame);
+  EXPECT_EQ(row[1], dataset_frame);
+  EXPECT_EQ(row[2], timestamp);
+}
+
+// slam and odometry write trajectory.csv as localize does: the run's frame, the dataset's own
+// name of it and its time. A folder whose first scan is 000001 (000000 left out): run frame 0 is
+// dataset frame 1, and with no times the timestamp stays empty, never made up.
+TEST(CliPoseFiles, SlamAndOdometryNameTheDatasetsFramesInTrajectoryCsv) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path dir = tmp.path(), data = scansWithout(dir, "000000.bin");
+  const std::string scans = " --dataset folder:" + (data / "lidar").string();
+  const Result slam =
+      run("slam" + scans + " --odometry " + (dir / "odom.txt").string() + " --config " +
+          eigenConfig(dir, "eigen.yaml") + " --out " + (dir / "slam").string());
+  ASSERT_EQ(slam.code, 0) << slam.err;
+  const std::filesystem::path slam_csv = dir / "slam" / "trajectory.csv";
+  EXPECT_EQ(lines(readFile(slam_csv)), 3u);  // the header and the two frames
+  expectFrameNames(slam_csv, 1, "0", "1", "");
+  expectFrameNames(slam_csv, 2, "1", "2", "");
+  EXPECT_EQ(csvLine(slam_csv, 0)[3], "slam_x");
+  const Result odometry = run("odometry" + scans + " --out " + (dir / "odo").string());
+  ASSERT_EQ(odometry.code, 0) << odometry.err;
+  expectFrameNames(dir / "odo" / "trajectory.csv", 2, "1", "2", "");
+  EXPECT_EQ(csvLine(dir / "odo" / "trajectory.csv", 0)[3], "odom_x");
+
+  // With the data's times (the simulator's), each row has its frame's time, as the TUM file.
+  const std::filesystem::path whole = copyOfDataset(dir / "whole");
+  const Result timed =
+      run("odometry --dataset " + whole.string() + " --out " + (dir / "timed").string());
+  ASSERT_EQ(timed.code, 0) << timed.err;
+  const std::string tum_time = readFile(dir / "timed" / "trajectory_tum.txt").substr(0, 8);
+  const std::string csv_time = csvLine(dir / "timed" / "trajectory.csv", 1).at(2);
+  EXPECT_FALSE(csv_time.empty());
+  EXPECT_EQ(csv_time.substr(0, 8), tum_time);
+}
+
+// On real data, the first ten scans of KITTI 00 as PCD files from scan 000004 on: LiDAR
+// odometry's trajectory.csv names run frame 0 as the dataset's frame 4.
+TEST(CliPoseFiles, OdometryOnRealScansFromALaterFrameNamesThemInTrajectoryCsv) {
+  const std::filesystem::path sample =
+      std::filesystem::path(SEMSEGMAP_SHARED_DATA) / "kitti00_first10_pcd";
+  if (!std::filesystem::exists(sample))
+    GTEST_SKIP() << "the real KITTI 00 PCD scans (../shared/data/kitti00_first10_pcd) are absent";
+  if (!SEMSEGMAP_WITH_PCL)
+    GTEST_SKIP() << "PCD files are read with PCL, which this build leaves out";
+  TempDir tmp;
+  const std::filesystem::path scans = tmp.path() / "scans";
+  std::filesystem::create_directories(scans);
+  for (int k = 4; k <= 6; ++k) {
+    const std::string name = "00000" + std::to_string(k) + ".pcd";
+    std::filesystem::create_symlink(sample / name, scans / name);
+  }
+  const std::filesystem::path out = tmp.path() / "odo";
+  const Result r = run("odometry --dataset folder:" + scans.string() + " --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(lines(readFile(out / "trajectory.csv")), 4u);
+  expectFrameNames(out / "trajectory.csv", 1, "0", "4", "");
+  expectFrameNames(out / "trajectory.csv", 3, "2", "6", "");
 }
 
 // Runs `semsegmap ARGS` with stderr into a pipe and stdout to /dev/null; once stderr shows
@@ -1114,6 +1222,103 @@ TEST(CliInterrupt, AnInterruptedLabelSetListsTheFramesDone) {
   EXPECT_TRUE(std::filesystem::exists(picture(done - 1)));
   EXPECT_FALSE(std::filesystem::exists(picture(done)));
   EXPECT_EQ(temporaryFiles(tmp.path()), std::vector<std::string>{});
+}
+
+// The one line an interrupted run prints on stderr, which begins with `prefix`; empty (a test
+// failure) when there is none or more than one.
+std::string interruptedLine(const std::string& err, const std::string& prefix) {
+  const size_t at = err.find(prefix);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "no '" << prefix << "' in\n" << err;
+    return "";
+  }
+  EXPECT_EQ(err.find(prefix, at + 1), std::string::npos) << err;  // one line
+  return err.substr(at, err.find('\n', at) - at);
+}
+
+// Ctrl-C during `demo`'s S2 run: the frame in hand finishes, the S2 folders are written whole
+// with its frames done, S3 never starts, localization.json and report.md say interrupted.
+TEST(CliInterrupt, AnInterruptedDemoWritesTheRunsDoneMarkedInterrupted) {
+  if (!built("demo")) GTEST_SKIP() << "demo needs the simulator";
+  if (!SEMSEGMAP_WITH_TORCH) GTEST_SKIP() << "demo's SemSegMap configuration needs libtorch";
+  TempDir tmp;
+  const std::filesystem::path out = tmp.path() / "demo";
+  const Result r = runAndInterrupt("demo --preset tiny --max-frames 12 --out " + out.string(),
+                                   "localize S2 [", 1);
+  EXPECT_EQ(r.code, 130) << r.err;
+  const std::string line = interruptedLine(r.err, "semsegmap demo: interrupted in localize S2 at ");
+  EXPECT_NE(line.find(" of 12; " + out.string() + " holds the work done, marked interrupted"),
+            std::string::npos)
+      << line;
+  const std::string json = readFile(out / "localization.json");
+  EXPECT_NE(json.find("\"interrupted\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"run\": \"S2\""), std::string::npos) << json;
+  EXPECT_EQ(json.find("\"run\": \"S3\""), std::string::npos) << json;
+  EXPECT_NE(readFile(out / "semsegmap_S2" / "summary.json").find("\"interrupted\": true"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(out / "semsegmap_S3"));
+  EXPECT_NE(readFile(out / "report.md").find("Partial: interrupted"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(out / "localization_accuracy.png"));
+  EXPECT_EQ(temporaryFiles(tmp.path()), std::vector<std::string>{});
+}
+
+// Ctrl-C while `eval localization` maps: the maps of the frames done are saved, no query run
+// starts, and localization.json says interrupted with no results.
+TEST(CliInterrupt, AnInterruptedLocalizationExperimentKeepsTheMapsOfTheFramesDone) {
+  if (!built("eval localization")) GTEST_SKIP() << "the experiment needs the simulator";
+  TempDir tmp;
+  const std::filesystem::path out = tmp.path() / "eval";
+  const std::string configs =
+      eigenConfig(tmp.path(), "a.yaml") + "," + eigenConfig(tmp.path(), "b.yaml");
+  const Result r = runAndInterrupt("eval localization --preset tiny --max-frames 12 --configs " +
+                                       configs + " --query-runs S2 --out " + out.string(),
+                                   "map S0 [", 1);
+  EXPECT_EQ(r.code, 130) << r.err;
+  const std::string line =
+      interruptedLine(r.err, "semsegmap eval localization: interrupted in map S0 at ");
+  EXPECT_NE(line.find(" of 12; " + out.string() + " holds the work done, marked interrupted"),
+            std::string::npos)
+      << line;
+  const std::string json = readFile(out / "localization.json");
+  EXPECT_NE(json.find("\"interrupted\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"results\": []"), std::string::npos) << json;
+  EXPECT_GT(std::filesystem::file_size(out / "maps" / "a.map"), 0u);
+  EXPECT_GT(std::filesystem::file_size(out / "maps" / "b.map"), 0u);
+  EXPECT_EQ(temporaryFiles(tmp.path()), std::vector<std::string>{});
+}
+
+// Ctrl-C during training: the epoch in hand is dropped, the model of the best epoch completed
+// stays (saved when it ended) with the history of the epochs completed, one line says so.
+TEST(CliInterrupt, AnInterruptedTrainingKeepsTheBestCompletedEpoch) {
+  if (!built("train")) GTEST_SKIP() << "training needs the simulator and libtorch";
+  TempDir tmp;
+  const std::filesystem::path model = tmp.path() / "net.model", history = tmp.path() / "h.csv";
+  const Result r = runAndInterrupt(
+      "train --descriptor semsegmap-net --dataset sim:world=1,run=S1,preset=tiny --max-frames 30 "
+      "--epochs 1000 --anchors-per-epoch 64 --threads 1 --history " +
+          history.string() + " --out " + model.string(),
+      "epoch 2/1000", 1);
+  EXPECT_EQ(r.code, 130) << r.err;
+  const std::string prefix = "semsegmap train: interrupted after ";
+  const std::string line = interruptedLine(r.err, prefix);
+  size_t done = 0;
+  ASSERT_EQ(std::sscanf(line.c_str() + prefix.size(), "%zu of 1000 epochs", &done), 1) << line;
+  EXPECT_GE(done, 1u);
+  EXPECT_NE(line.find("; " + model.string() + " holds the model of epoch "), std::string::npos)
+      << line;
+  EXPECT_NE(line.find(", the best of the " + std::to_string(done) + " epochs done"),
+            std::string::npos)
+      << line;
+  EXPECT_EQ(lines(readFile(history)), done + 1);  // the header and one row per epoch completed
+  EXPECT_GT(std::filesystem::file_size(model), 0u);
+  EXPECT_EQ(temporaryFiles(tmp.path()), std::vector<std::string>{});
+  // A whole model: a map describes its segments with it.
+  std::ofstream(tmp.path() / "net.yaml")
+      << "descriptor:\n  kind: semsegmap-net\n  model: " << model.string() << "\n";
+  const Result map =
+      run("map --dataset sim:preset=tiny,frames=2 --config " + (tmp.path() / "net.yaml").string() +
+          " --out " + (tmp.path() / "m.map").string());
+  EXPECT_EQ(map.code, 0) << map.err;
 }
 
 // map --out naming a directory or an unwritable place used to fail after every frame.

@@ -116,12 +116,14 @@ std::vector<std::string> words(const std::string& text) {
   return out;
 }
 
-// "  --name PLACEHOLDER  help (default: X)", the help wrapped at 100 columns under itself.
+// "  --name PLACEHOLDER  help (default: X)", the help wrapped at 100 columns under itself. A help
+// that says its default itself, in words ("(default: shipped)"), is not given a second one.
 std::string optionLine(const OptionSpec& o, size_t width) {
   const std::string left = optionText(o);
   std::string help = o.help;
   if (o.required) help += " (required)";
-  if (!o.fallback.empty()) help += " (default: " + o.fallback + ")";
+  if (!o.fallback.empty() && help.find("(default: ") == std::string::npos)
+    help += " (default: " + o.fallback + ")";
   return "  " + left + std::string(width - left.size(), ' ') + wrap(words(help), 2 + width, 100);
 }
 

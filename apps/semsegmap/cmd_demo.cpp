@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "cli_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "resources.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -62,8 +63,12 @@ int runDemo(const CliArgs& a) {
   std::cout << "semsegmap demo: world " << config.world_seed << " (" << config.preset
             << "), map S0, localize S2 (sunny) and S3 (sunrise) with SemSegMap and SegMap\n";
   viz::writeSimOverview(sim::worldPreset(config.preset, config.world_seed), out / "overview.png");
+  config.stop = stopToken();
   StageProgress progress;
-  const LocalizationExperiment e = runLocalizationExperiment(config, out, std::ref(progress));
+  const LocalizationExperiment e = evaluateLocalization(config, out, std::ref(progress));
+  // Ctrl-C before the first frame: nothing worth keeping (main removes the folder's new files).
+  if (e.interrupted && !progress.started()) return interruptedStages("demo", progress, "");
+  writeLocalizationFiles(e, out);
   std::cout << "\n" << localizationTable(e) << "\n";
 
   ReportContext context;
@@ -74,10 +79,11 @@ int runDemo(const CliArgs& a) {
   context.pictures = {"overview.png"};
   context.view = writeDemoView(e, out);
   context.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  context.interrupted = e.interrupted;
   writeBytesAtomically(out / "report.md", paperReport(context, nullptr, nullptr, &e));
   std::printf("wrote %s with its pictures in %.1f min\n", (out / "report.md").string().c_str(),
               context.seconds / 60.0);
-  return 0;
+  return e.interrupted ? interruptedStages("demo", progress, out.string()) : 0;
 }
 
 }  // namespace
@@ -94,7 +100,8 @@ const CommandSpec& demoCommand() {
       },
       "It reads the shipped config/semsegmap.yaml, config/segmap.yaml and models, from the\n"
       "installed share/semsegmap or the source tree, wherever it is run from.\n",
-      runDemo};
+      runDemo,
+      /*stops_between_frames=*/true};
   return command;
 }
 

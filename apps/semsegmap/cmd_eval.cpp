@@ -4,11 +4,13 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "eval_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "resources.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -104,59 +106,89 @@ LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   return c;
 }
 
+// Each experiment runs with Ctrl-C's stop token (interrupt.h): stopped before its first frame it
+// writes nothing; stopped later it writes what it did as whole files marked interrupted, prints
+// its table and one line on stderr, and returns 130.
+int experimentEnd(const CliArgs& a, bool interrupted, const StageProgress& progress) {
+  return interrupted ? interruptedStages(a.command().name, progress, a.get("out")) : 0;
+}
+
 int runEvalSegmentation(const CliArgs& a) {
+  const std::filesystem::path out = a.get("out");
+  SegmentationExperimentConfig c = segmentationConfig(a);
+  c.stop = stopToken();
   StageProgress progress;
-  const SegmentationExperiment e =
-      runSegmentationExperiment(segmentationConfig(a), a.get("out"), std::ref(progress));
-  std::cout << segmentationTable(e) << "wrote "
-            << (std::filesystem::path(a.get("out")) / "segmentation.json").string()
+  const SegmentationExperiment e = evaluateSegmentation(c, std::ref(progress));
+  if (e.interrupted && !progress.started()) return experimentEnd(a, true, progress);
+  writeSegmentationFiles(e, out);
+  std::cout << segmentationTable(e) << "wrote " << (out / "segmentation.json").string()
             << ", segmentation.png\n";
-  return 0;
+  return experimentEnd(a, e.interrupted, progress);
 }
 
 int runEvalDescriptors(const CliArgs& a) {
+  const std::filesystem::path out = a.get("out");
+  DescriptorExperimentConfig c = descriptorConfig(a);
+  c.stop = stopToken();
   StageProgress progress;
-  const DescriptorExperiment e =
-      runDescriptorExperiment(descriptorConfig(a), a.get("out"), std::ref(progress));
-  std::cout << descriptorTable(e) << "wrote "
-            << (std::filesystem::path(a.get("out")) / "descriptors.json").string()
+  const DescriptorExperiment e = evaluateDescriptors(c, std::ref(progress));
+  if (e.interrupted && !progress.started()) return experimentEnd(a, true, progress);
+  writeDescriptorFiles(e, out);
+  std::cout << descriptorTable(e) << "wrote " << (out / "descriptors.json").string()
             << ", descriptors.png\n";
-  return 0;
+  return experimentEnd(a, e.interrupted, progress);
 }
 
 int runEvalLocalization(const CliArgs& a) {
+  const std::filesystem::path out = a.get("out");
+  LocalizationExperimentConfig c = localizationConfig(a);
+  c.stop = stopToken();
   StageProgress progress;
-  const LocalizationExperiment e =
-      runLocalizationExperiment(localizationConfig(a), a.get("out"), std::ref(progress));
-  std::cout << localizationTable(e) << "wrote "
-            << (std::filesystem::path(a.get("out")) / "localization.json").string()
+  const LocalizationExperiment e = evaluateLocalization(c, out, std::ref(progress));
+  if (e.interrupted && !progress.started()) return experimentEnd(a, true, progress);
+  writeLocalizationFiles(e, out);
+  std::cout << localizationTable(e) << "wrote " << (out / "localization.json").string()
             << ", localization_accuracy.png and one folder per run\n";
-  return 0;
+  return experimentEnd(a, e.interrupted, progress);
 }
 
+// The three experiments in turn; after Ctrl-C no further one starts, and report.md shows those
+// that ran, saying it is partial.
 int runEvalPaper(const CliArgs& a) {
   const std::filesystem::path out = a.get("out");
   const auto start = std::chrono::steady_clock::now();
   // Every configuration and model is read before the first experiment starts.
-  const SegmentationExperimentConfig sc = segmentationConfig(a);
-  const DescriptorExperimentConfig dc = descriptorConfig(a);
-  const LocalizationExperimentConfig lc = localizationConfig(a);
+  SegmentationExperimentConfig sc = segmentationConfig(a);
+  DescriptorExperimentConfig dc = descriptorConfig(a);
+  LocalizationExperimentConfig lc = localizationConfig(a);
+  sc.stop = dc.stop = lc.stop = stopToken();
   StageProgress progress;
-  const SegmentationExperiment s = runSegmentationExperiment(sc, out, std::ref(progress));
-  std::cout << segmentationTable(s) << "\n";
-  const DescriptorExperiment d = runDescriptorExperiment(dc, out, std::ref(progress));
-  std::cout << descriptorTable(d) << "\n";
-  const LocalizationExperiment l = runLocalizationExperiment(lc, out, std::ref(progress));
-  std::cout << localizationTable(l) << "\n";
+  std::optional<SegmentationExperiment> s;
+  std::optional<DescriptorExperiment> d;
+  std::optional<LocalizationExperiment> l;
+  s = evaluateSegmentation(sc, std::ref(progress));
+  if (s->interrupted && !progress.started()) return experimentEnd(a, true, progress);
+  writeSegmentationFiles(*s, out);
+  std::cout << segmentationTable(*s) << "\n";
+  if (!s->interrupted) {
+    d = runDescriptorExperiment(dc, out, std::ref(progress));
+    std::cout << descriptorTable(*d) << "\n";
+  }
+  if (d && !d->interrupted) {
+    l = runLocalizationExperiment(lc, out, std::ref(progress));
+    std::cout << localizationTable(*l) << "\n";
+  }
   ReportContext context;
   context.title = "SemSegMap against SegMap: the paper's experiments on world " +
                   std::to_string(sc.world_seed) + " (" + sc.preset + ")";
   context.command = "semsegmap eval paper";
   for (const std::string& arg : a.args()) context.command += " " + arg;
   context.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  writeBytesAtomically(out / "report.md", paperReport(context, &s, &d, &l));
+  context.interrupted = s->interrupted || (d && d->interrupted) || (l && l->interrupted);
+  writeBytesAtomically(out / "report.md",
+                       paperReport(context, &*s, d ? &*d : nullptr, l ? &*l : nullptr));
   std::cout << "wrote " << (out / "report.md").string() << "\n";
-  return 0;
+  return experimentEnd(a, context.interrupted, progress);
 }
 
 // The options of the experiments, each declared once.
@@ -201,28 +233,32 @@ const std::vector<const CommandSpec*>& simulatedEvalCommands() {
       "segment consistency at revisits (convex hull IoU) -> segmentation.json",
       {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kSegmentationRun},
       "",
-      runEvalSegmentation};
+      runEvalSegmentation,
+      /*stops_between_frames=*/true};
   static const CommandSpec descriptors{
       "eval descriptors",
       "retrieval of segments from their partial observations -> descriptors.json",
       {kWorldSeed, kOut, kPreset, kMaxFrames, kConfig, kModels, kDescriptors, kThreads,
        kDescriptorRun},
       "",
-      runEvalDescriptors};
+      runEvalDescriptors,
+      /*stops_between_frames=*/true};
   static const CommandSpec localization{
       "eval localization",
       "maps one run, localizes the others with each config -> localization.json",
       {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kMapRun, kQueryRuns, kLabelNoise,
        kQueryOdometry, kRig},
       "",
-      runEvalLocalization};
+      runEvalLocalization,
+      /*stops_between_frames=*/true};
   static const CommandSpec paper{
       "eval paper",
       "the segmentation, descriptor and localization experiments, and report.md",
       {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kSegmentationRun, kConfig, kModels,
        kDescriptors, kThreads, kDescriptorRun, kMapRun, kQueryRuns},
       "",
-      runEvalPaper};
+      runEvalPaper,
+      /*stops_between_frames=*/true};
   static const std::vector<const CommandSpec*> all = {&segmentation, &descriptors, &localization,
                                                       &paper};
   return all;

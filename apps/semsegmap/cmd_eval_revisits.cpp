@@ -8,6 +8,7 @@
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "eval_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/eval/revisit_experiment.h"
@@ -32,13 +33,16 @@ int runEvalRevisits(const CliArgs& a) {
     requireDescriberBuilt(config.config.descriptor, config.path.string());
   // LiDAR odometry and a segmentation network come from the first configuration's sections.
   const std::unique_ptr<FrameSource> source = openDatasetArg(a, c.configs.front().path);
+  c.stop = stopToken();
   StageProgress progress;
   const std::filesystem::path out = a.get("out");
   const RevisitExperiment e = evaluateRevisits(*source, c, out, std::ref(progress));
+  // Ctrl-C before the first frame: nothing worth keeping (main removes what the run made).
+  if (e.interrupted && !progress.started()) return interruptedStages("eval revisits", progress, "");
   writeRevisitFiles(e, out);
   std::cout << revisitTable(e) << "wrote " << (out / "revisits.json").string()
             << ", revisits.png and one folder per configuration\n";
-  return 0;
+  return e.interrupted ? interruptedStages("eval revisits", progress, out.string()) : 0;
 }
 
 }  // namespace
@@ -66,7 +70,9 @@ const CommandSpec& evalRevisitsCommand() {
             "the kidnapped robot: wake up at every EVERY-th query frame (default N) with an "
             "empty local map and localize from the N frames from there"},
            {"out", Value::kText, "DIR", "", "output folder", kRequired}}),
-      "", runEvalRevisits};
+      "",
+      runEvalRevisits,
+      /*stops_between_frames=*/true};
   return revisits;
 }
 

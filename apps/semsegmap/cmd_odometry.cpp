@@ -1,6 +1,7 @@
 // semsegmap odometry: LiDAR odometry over a dataset, from its scans alone; writes the trajectory
-// (TUM and KITTI formats; KITTI alone when the data has no frame times), summary.json and, with
-// ground truth, the KITTI relative error, the ATE and trajectory.png.
+// (TUM and KITTI formats, KITTI alone when the data has no frame times; trajectory.csv with the
+// dataset's frame numbers and times), summary.json and, with ground truth, the KITTI relative
+// error, the ATE and trajectory.png.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -51,10 +52,11 @@ int runOdometryCommand(const CliArgs& a) {
   if (!run.has_frame_times)
     note(
         "the data has no frame times: no trajectory_tum.txt (its times would be made up); "
-        "trajectory_kitti.txt holds the poses, line i for frame i of the run");
+        "trajectory_kitti.txt holds the poses, line i for frame i of the run, and "
+        "trajectory.csv the dataset's frame numbers");
   std::cout << "wrote " << (run.has_frame_times ? "trajectory_tum.txt, " : "")
-            << "trajectory_kitti.txt, summary.json" << (errors ? ", trajectory.png" : "") << " to "
-            << out.string() << "\n";
+            << "trajectory_kitti.txt, trajectory.csv, summary.json"
+            << (errors ? ", trajectory.png" : "") << " to " << out.string() << "\n";
   if (run.interrupted) return interruptedRun("odometry", run.frames.size(), total, out.string());
   return 0;
 }

@@ -1,6 +1,7 @@
 // semsegmap slam: mapping on odometry with loop closure in a pose graph; writes the trajectory
-// (TUM and KITTI formats; KITTI alone when the data has no frame times), the loop closures, the
-// error before and after, and a picture.
+// (TUM and KITTI formats, KITTI alone when the data has no frame times; trajectory.csv with the
+// dataset's frame numbers and times), the loop closures, the error before and after, and a
+// picture.
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -25,20 +26,22 @@ namespace {
 // The loop-closed and the odometry trajectory; the names of the files written. TUM files carry
 // times, and a time made up from the frame rate would pair the poses with the wrong data in evo
 // or with another sensor's log: without the data's times only KITTI files (one line per frame
-// of the run, in order) are written, and a note says so.
+// of the run, in order) are written, and a note says so. trajectory.csv names each frame as the
+// dataset does (its number and time, empty where it has none), as localize's does.
 std::string writeTrajectories(const std::filesystem::path& out, const SlamRun& run) {
+  writeTrajectoryCsv(out / "trajectory.csv", run);
   writeKitti(out / "trajectory_kitti.txt", run.trajectory);
   if (!run.has_frame_times) {
     writeKitti(out / "odometry_kitti.txt", run.trajectory_odom);
     note(
         "the data has no frame times: no trajectory_tum.txt or odometry_tum.txt (their times "
         "would be made up); trajectory_kitti.txt and odometry_kitti.txt hold the poses, line i "
-        "for frame i of the run");
-    return "trajectory_kitti.txt, odometry_kitti.txt";
+        "for frame i of the run, and trajectory.csv the dataset's frame numbers");
+    return "trajectory.csv, trajectory_kitti.txt, odometry_kitti.txt";
   }
   writeTum(out / "trajectory_tum.txt", run.trajectory);
   writeTum(out / "odometry_tum.txt", run.trajectory_odom);
-  return "trajectory_tum.txt, trajectory_kitti.txt, odometry_tum.txt";
+  return "trajectory.csv, trajectory_tum.txt, trajectory_kitti.txt, odometry_tum.txt";
 }
 
 int runSlamCommand(const CliArgs& a) {

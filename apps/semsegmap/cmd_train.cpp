@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli_args.h"
+#include "interrupt.h"
 #include "progress.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/artefacts/training_cache.h"
@@ -66,6 +67,7 @@ TrainingSet loadOrExtract(const std::vector<std::string>& specs, const PipelineC
         }
         progress->update(done);
       });
+  if (set.interrupted) return set;  // a part of the data, never cached as the whole
   std::cout << "extracted " << set.observations.size() << " observations\n";
   if (!cache.empty()) {
     writeTrainingCache(cache, set, made_from);
@@ -206,6 +208,28 @@ std::shared_ptr<DescriptorNetImpl> loadTeacher(const CliArgs& a, const TrainConf
   return teacher;
 }
 
+// What a training run ends with: the best epoch and the model written. Ctrl-C keeps the model of
+// the best epoch completed, which the run saved when that epoch ended, and the history of the
+// epochs completed; stopped in the first epoch, it has written nothing.
+int trainEnd(const CliArgs& a, const TrainConfig& config, const TrainResult& result) {
+  const size_t epochs = result.history.size();
+  const std::string where =
+      "after " + std::to_string(epochs) + " of " + std::to_string(config.epochs) + " epochs";
+  if (epochs == 0) return interruptedWork("train", where, "");
+  if (a.has("history")) std::cout << "wrote " << a.get("history") << "\n";
+  std::printf("trained on %zu observations (%zu anchors), validated on %zu\n",
+              result.train_observations, result.anchors, result.validation_observations);
+  const EpochStats& best = result.history.at(static_cast<size_t>(result.best_epoch - 1));
+  std::printf("best epoch %d: val top1 %.3f top5 %.3f\n", best.epoch, best.validation.top1,
+              best.validation.top5);
+  std::cout << "wrote " << a.get("out") << " (" << descriptorName(config.net.kind)
+            << ", fingerprint " << netFingerprint(*result.net) << ")\n";
+  if (!result.interrupted) return 0;
+  return interruptedWork("train", where,
+                         a.get("out") + " holds the model of epoch " + std::to_string(best.epoch) +
+                             ", the best of the " + std::to_string(epochs) + " epochs done");
+}
+
 int runTrain(const CliArgs& a) {
   const TrainConfig config = trainConfig(a);
   const auto teacher = loadTeacher(a, config);
@@ -221,10 +245,13 @@ int runTrain(const CliArgs& a) {
     config_text = readFileBytes(a.get("config"));
   }
 
+  extraction.stop = stopToken();
   const TrainingSet data =
       loadOrExtract(specs, pipeline, config_text, extraction, a.has("cache") ? a.get("cache") : "");
+  if (data.interrupted) return interruptedWork("train", "while extracting the training data", "");
   EpochProgress progress(config.epochs, teacher != nullptr);
   TrainCallbacks callbacks;
+  callbacks.stop = stopToken();
   callbacks.step = [&](int epoch, size_t done, size_t total, double loss) {
     progress.step(epoch, done, total, loss);
   };
@@ -238,16 +265,7 @@ int runTrain(const CliArgs& a) {
   };
   callbacks.best = [&](DescriptorNetImpl& net) { saveNet(out, net); };
   const TrainResult result = trainDescriptor(data, config, callbacks, teacher);
-
-  if (a.has("history")) std::cout << "wrote " << a.get("history") << "\n";
-  std::printf("trained on %zu observations (%zu anchors), validated on %zu\n",
-              result.train_observations, result.anchors, result.validation_observations);
-  const EpochStats& best = result.history.at(static_cast<size_t>(result.best_epoch - 1));
-  std::printf("best epoch %d: val top1 %.3f top5 %.3f\n", best.epoch, best.validation.top1,
-              best.validation.top5);
-  std::cout << "wrote " << out.string() << " (" << descriptorName(config.net.kind)
-            << ", fingerprint " << netFingerprint(*result.net) << ")\n";
-  return 0;
+  return trainEnd(a, config, result);
 }
 
 }  // namespace
@@ -335,7 +353,8 @@ const CommandSpec& trainCommand() {
                   "new spec\n(';' also separates): sim:world=1,run=S1,sim:world=1,run=S1,"
                   "condition=sunrise\n\n") +
           kDatasetNotes,
-      runTrain};
+      runTrain,
+      /*stops_between_frames=*/true};
   return command;
 }
 

@@ -52,14 +52,24 @@ bool stopRequested() {
 
 int interruptedRun(const std::string& command, size_t done, size_t total,
                    const std::string& written) {
+  return interruptedWork(
+      command, "after " + std::to_string(done) + " of " + std::to_string(total) + " frames",
+      done > 0 ? written + " holds the " + std::to_string(done) + " frames done" : "");
+}
+
+int interruptedWork(const std::string& command, const std::string& where, const std::string& kept) {
   endProgressLine();
-  g_keep_outputs = done > 0;
-  std::cerr << "semsegmap " << command << ": interrupted after " << done << " of " << total
-            << " frames; "
-            << (done > 0 ? written + " holds the " + std::to_string(done) + " frames done"
-                         : std::string("nothing written"))
-            << "\n";
+  g_keep_outputs = !kept.empty();
+  std::cerr << "semsegmap " << command << ": interrupted " << where << "; "
+            << (kept.empty() ? std::string("nothing written") : kept) << "\n";
   return kExitInterrupted;
+}
+
+int interruptedStages(const std::string& command, const StageProgress& progress,
+                      const std::string& out) {
+  return interruptedWork(
+      command, progress.where(),
+      progress.started() ? out + " holds the work done, marked interrupted" : "");
 }
 
 bool interruptedRunKeepsOutputs() {

@@ -27,6 +27,15 @@ bool stopRequested();
 // that nothing was written), and returns kExitInterrupted. `written` names the outputs.
 int interruptedRun(const std::string& command, size_t done, size_t total,
                    const std::string& written);
+// The same for work that is more than one run of frames (the experiments, training): `where` says
+// how far it got ("in localize S2 at 3 of 10", "after 2 of 8 epochs"), `kept` what the outputs
+// hold; an empty `kept` says nothing was written (main then removes the outputs).
+int interruptedWork(const std::string& command, const std::string& where, const std::string& kept);
+// interruptedWork for an experiment that reported its stages to `progress`: `out` holds the work
+// done, marked interrupted, unless not even one frame was done.
+class StageProgress;
+int interruptedStages(const std::string& command, const StageProgress& progress,
+                      const std::string& out);
 // Whether an interrupted run wrote outputs worth keeping (a frame or more done): main keeps its
 // outputs then, and removes them as a failed run's otherwise.
 bool interruptedRunKeepsOutputs();

@@ -112,11 +112,23 @@ class StageProgress {
       bar_ = std::make_unique<Progress>(stage, total);
     }
     bar_->update(done, total);
+    done_ = done;
+    total_ = total;
+    started_ = started_ || done > 0;
+  }
+  // Whether any work was reported done: an experiment stopped before has nothing to keep.
+  bool started() const { return started_; }
+  // How far it got, for the line of an interrupted run: "in localize S2 at 3 of 10".
+  std::string where() const {
+    if (stage_.empty()) return "before its first frame";
+    return "in " + stage_ + " at " + std::to_string(done_) + " of " + std::to_string(total_);
   }
 
  private:
   std::string stage_;
   std::unique_ptr<Progress> bar_;
+  size_t done_ = 0, total_ = 0;
+  bool started_ = false;
 };
 
 }  // namespace semsegmap::app

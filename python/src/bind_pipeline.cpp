@@ -1,7 +1,9 @@
 // pipeline/: the front end frame by frame (Pipeline), its results and local segments, and the
 // mapping and localization modes (pipeline/modes.h) by frame or over a whole dataset. Every call
 // that processes frames releases the GIL.
+#include <atomic>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 
 #include "bindings.h"
@@ -57,6 +59,45 @@ py::array_t<EnrichedPoint> cloudArray(EnrichedCloud cloud) {
   return ownedArray(std::move(cloud));
 }
 
+// semsegmap.StopFlag: a Python caller's request to stop a run between frames, set from another
+// thread (the run releases the GIL) or a callback; the run ends with the frames done.
+struct StopFlag {
+  std::atomic<bool> requested{false};
+};
+
+// How a Python run stops between frames: at the caller's StopFlag, or at Ctrl-C. The library
+// checks one flag (RunOptions::stop) before each frame; after each frame this sets it from the
+// caller's flag, and from Python's pending signals (PyErr_CheckSignals, with the GIL): a
+// KeyboardInterrupt then ends the run with the frame in hand finished and is raised after it
+// (rethrow), as Ctrl-C would have raised it had the GIL been held.
+class RunStop {
+ public:
+  explicit RunStop(const StopFlag* flag) : flag_(flag) { poll(); }
+  void install(RunOptions& options) {
+    options.stop = StopToken(stop_);
+    options.progress = [this](size_t, size_t) {
+      poll();
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {
+        signal_.emplace();  // fetches the error the signal's handler raised
+        stop_ = true;
+      }
+    };
+  }
+  // With the GIL, after the run: the signal's error, if one stopped it.
+  void rethrow() {
+    if (signal_) throw std::move(*signal_);
+  }
+
+ private:
+  void poll() {
+    if (flag_ && flag_->requested.load()) stop_ = true;
+  }
+  const StopFlag* flag_;
+  std::atomic<bool> stop_{false};
+  std::optional<py::error_already_set> signal_;
+};
+
 // Descriptors (one vector each, all of one size) as an (M, D) matrix.
 Eigen::MatrixXf rowsOf(const std::vector<Eigen::VectorXf>& d) {
   Eigen::MatrixXf m(static_cast<Eigen::Index>(d.size()), d.empty() ? 0 : d[0].size());
@@ -102,8 +143,22 @@ void bindResults(py::module_& m) {
   py::class_<RunStats> stats(m, "RunStats", "Frames processed and the pipeline's time over them");
   stats.def_readonly("frames", &RunStats::frames)
       .def_readonly("total", &RunStats::total)
+      .def_readonly("interrupted", &RunStats::interrupted,
+                    "a stop request (StopFlag, Ctrl-C) ended the run early: `frames` are those "
+                    "done")
       .def_property_readonly("fps", &RunStats::fps);
-  defRepr(stats, "RunStats", {"frames", "fps"});
+  defRepr(stats, "RunStats", {"frames", "fps", "interrupted"});
+  py::class_<StopFlag>(m, "StopFlag",
+                       "A request to stop a run between frames: pass it as stop= to run_mapping "
+                       "or run_localization and set() it, e.g. from another thread; the run "
+                       "ends with the frames done (stats.interrupted)")
+      .def(py::init<>())
+      .def(
+          "set", [](StopFlag& f) { f.requested = true; }, "ask the runs given this flag to stop")
+      .def(
+          "clear", [](StopFlag& f) { f.requested = false; }, "to use the flag for another run")
+      .def_property_readonly(
+          "is_set", [](const StopFlag& f) { return f.requested.load(); }, "whether set()");
 
   py::class_<SegmentObservation>(m, "SegmentObservation", "One observation of a segment")
       .def_readonly("frame_index", &SegmentObservation::frame_index)
@@ -268,17 +323,25 @@ void bindMapping(py::module_& m) {
   m.def(
       "run_mapping",
       [](FrameSource& source, const PipelineConfig& c, std::shared_ptr<Describer> d,
-         const py::object& poses, size_t max_frames) {
+         const py::object& poses, size_t max_frames, const StopFlag* stop) {
         const PoseSource p = posesFor(poses, source.info());
         d = required(std::move(d), "run_mapping");
         RunOptions options;
         options.max_frames = max_frames;
-        py::gil_scoped_release release;
-        return resultOf(runMapping(source, c, p, std::move(d), options));
+        RunStop stopping(stop);
+        stopping.install(options);
+        std::optional<MappingResult> result;
+        {
+          py::gil_scoped_release release;
+          result = resultOf(runMapping(source, c, p, std::move(d), options));
+        }
+        stopping.rethrow();
+        return std::move(*result);
       },
       py::arg("dataset"), py::arg("config"), py::arg("describer"), py::arg("poses") = py::none(),
-      py::arg("max_frames") = 0,
-      "Maps the first max_frames frames (0: all), as `semsegmap map` does");
+      py::arg("max_frames") = 0, py::arg("stop") = py::none(),
+      "Maps the first max_frames frames (0: all), as `semsegmap map` does; a set StopFlag or "
+      "Ctrl-C ends it between frames (Ctrl-C then raises KeyboardInterrupt)");
 }
 
 // A record's error against ground truth; None without it (a 0.0 would read as perfect).
@@ -414,17 +477,27 @@ void bindLocalization(py::module_& m) {
   m.def(
       "run_localization",
       [](FrameSource& source, const PipelineConfig& c, std::shared_ptr<TargetMap> map,
-         std::shared_ptr<Describer> d, size_t max_frames, bool allow_config_mismatch) {
+         std::shared_ptr<Describer> d, size_t max_frames, bool allow_config_mismatch,
+         const StopFlag* stop) {
         d = required(std::move(d), "run_localization");
         RunOptions options;
         options.max_frames = max_frames;
-        py::gil_scoped_release release;
-        return runLocalization(source, c, std::shared_ptr<const TargetMap>(std::move(map)),
-                               std::move(d), options, settingsCheck(allow_config_mismatch));
+        RunStop stopping(stop);
+        stopping.install(options);
+        std::optional<LocalizationRun> run;
+        {
+          py::gil_scoped_release release;
+          run = runLocalization(source, c, std::shared_ptr<const TargetMap>(std::move(map)),
+                                std::move(d), options, settingsCheck(allow_config_mismatch));
+        }
+        stopping.rethrow();
+        return std::move(*run);
       },
       py::arg("dataset"), py::arg("config"), py::arg("map"), py::arg("describer"),
       py::arg("max_frames") = 0, py::arg("allow_config_mismatch") = false,
-      "Localizes the first max_frames frames (0: all), as `semsegmap localize` does");
+      py::arg("stop") = py::none(),
+      "Localizes the first max_frames frames (0: all), as `semsegmap localize` does; a set "
+      "StopFlag or Ctrl-C ends it between frames (Ctrl-C then raises KeyboardInterrupt)");
 }
 
 }  // namespace

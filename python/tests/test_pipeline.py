@@ -2,6 +2,8 @@
 and descriptors, timings; the GIL released while frames are processed."""
 
 import copy
+import os
+import signal
 import threading
 import time
 
@@ -166,3 +168,47 @@ def test_processing_releases_the_gil(eigen_config):
     assert done["run"].stats.frames == 8
     # Holding the GIL would stall this loop for the whole run (a tick or two).
     assert ticks > 0.1 * seconds / 0.005, (ticks, seconds)
+
+
+def test_a_stop_flag_ends_a_run_between_frames(eigen_config):
+    """StopFlag.set() from another thread ends the run after the frame in hand: the result holds
+    the frames done, marked interrupted."""
+    ds = ssm.open_dataset(TINY_S1)
+    d = ssm.make_describer(eigen_config.descriptor)
+    stop = ssm.StopFlag()
+    assert not stop.is_set
+    done = {}
+    worker = threading.Thread(target=lambda: done.update(
+        run=ssm.run_mapping(ds, eigen_config, d, max_frames=200, stop=stop)))
+    worker.start()
+    time.sleep(0.5)
+    stop.set()
+    worker.join()
+    stats = done["run"].stats
+    assert stats.interrupted and 0 < stats.frames < 200, stats
+    assert len(done["run"].trajectory) == stats.frames
+
+    # Set before the run: no frame starts. clear() makes the flag serve another run.
+    map_ = ssm.run_mapping(ds, eigen_config, d, max_frames=3).map
+    run = ssm.run_localization(ds, eigen_config, map_, d, max_frames=3, stop=stop)
+    assert run.stats.interrupted and run.stats.frames == 0
+    stop.clear()
+    run = ssm.run_localization(ds, eigen_config, map_, d, max_frames=3, stop=stop)
+    assert not run.stats.interrupted and run.stats.frames == 3
+
+
+def test_ctrl_c_ends_a_run_between_frames_with_keyboard_interrupt(eigen_config):
+    """SIGINT during a run raises KeyboardInterrupt once the frame in hand is done, not after the
+    last frame."""
+    ds = ssm.open_dataset(TINY_S1)
+    d = ssm.make_describer(eigen_config.descriptor)
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        ssm.run_mapping(ds, eigen_config, d, max_frames=200)
+    timer.join()
+    whole = time.monotonic()
+    ssm.run_mapping(ds, eigen_config, d, max_frames=200)
+    # Stopped well before the whole run's time.
+    assert whole - start < 0.5 * (time.monotonic() - whole)

@@ -74,9 +74,11 @@ struct FrameStamp {
   std::optional<size_t> number;
   std::optional<double> time_s;
 };
+inline FrameStamp stampOf(const Frame& frame, bool has_frame_times) {
+  return {frame.number, has_frame_times ? std::optional<double>(frame.timestamp_s) : std::nullopt};
+}
 inline FrameStamp stampOf(const Frame& frame, const DatasetInfo& info) {
-  return {frame.number,
-          info.has_frame_times ? std::optional<double>(frame.timestamp_s) : std::nullopt};
+  return stampOf(frame, info.has_frame_times);
 }
 
 // What every FrameSource throws for an index past its end.

@@ -16,7 +16,7 @@ TrainingSet extractTrainingSet(const std::vector<std::string>& specs,
   TrainingSet set;
   set.sources = specs;
   for (const auto& spec : specs) set.source_worlds.push_back(worldOf(spec));
-  for (size_t i = 0; i < specs.size(); ++i) {
+  for (size_t i = 0; i < specs.size() && !set.interrupted; ++i) {
     auto source = openDataset(specs[i]);
     appendObservations(*source, static_cast<uint16_t>(i), pipeline, config, set, progress);
   }

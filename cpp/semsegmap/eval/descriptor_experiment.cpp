@@ -52,6 +52,7 @@ DescriptorExperiment evaluateDescriptors(const DescriptorExperimentConfig& cfg,
   ExtractionConfig extraction;
   extraction.max_frames = cfg.max_frames;
   extraction.min_purity = 0.0f;  // every segment counts, as it would in a target map
+  extraction.stop = cfg.stop;
   const TrainingSet set = extractTrainingSet({e.dataset}, cfg.segmentation.config, extraction,
                                              [&](size_t done, size_t total, size_t) {
                                                if (progress)
@@ -61,11 +62,13 @@ DescriptorExperiment evaluateDescriptors(const DescriptorExperimentConfig& cfg,
   e.segments = q.targets.size();
   e.queries = q.queries.size();
   e.bands = defaultCompletenessBands();
-  for (size_t d = 0; d < describers.size(); ++d) {
+  e.interrupted = set.interrupted;
+  for (size_t d = 0; d < describers.size() && !e.interrupted; ++d) {
     if (progress) progress("describe", d, describers.size());
+    if ((e.interrupted = cfg.stop.stopRequested())) break;
     e.results.push_back(evaluateRetrieval(*describers[d], set, q, e.bands, cfg.max_k));
   }
-  if (progress) progress("describe", describers.size(), describers.size());
+  if (progress) progress("describe", e.results.size(), describers.size());
   return e;
 }
 
@@ -74,6 +77,7 @@ nlohmann::ordered_json toJson(const DescriptorExperiment& e) {
   j["dataset"] = e.dataset;
   j["segments"] = e.segments;
   j["queries"] = e.queries;
+  j["interrupted"] = e.interrupted;  // of the frames and descriptors done before Ctrl-C
   j["bands"] = nlohmann::ordered_json::array();
   for (const CompletenessBand& b : e.bands) j["bands"].push_back(b.name);
   j["descriptors"] = nlohmann::ordered_json::array();
@@ -125,6 +129,7 @@ std::string descriptorTable(const DescriptorExperiment& e) {
     std::snprintf(v, sizeof(v), " %.0f |\n", r.segments_per_second);
     t << v;
   }
+  if (e.interrupted) t << partialNote();
   return t.str();
 }
 

@@ -23,6 +23,9 @@ struct DescriptorExperimentConfig {
   std::vector<std::string> descriptors = {"semsegmap-net", "segmap-cnn", "fpfh", "eigen"};
   int threads = 0;
   int max_k = 50;
+  // Checked before each frame and each descriptor (Ctrl-C in the CLI): the segments of the
+  // frames done are ranked by the descriptors done.
+  StopToken stop;
 };
 
 struct DescriptorExperiment {
@@ -31,6 +34,7 @@ struct DescriptorExperiment {
   size_t segments = 0, queries = 0;
   std::vector<CompletenessBand> bands;
   std::vector<DescriptorRetrieval> results;
+  bool interrupted = false;  // the stop request ended it early
 };
 
 // Segments the run and ranks the observations with every descriptor; writes nothing.

@@ -21,10 +21,11 @@ std::string simulatedRunSpec(uint64_t world_seed, const std::string& run, const 
   return spec;
 }
 
-void forEachFrame(FrameSource& source, const std::string& stage, const ExperimentProgress& progress,
-                  const std::function<void(const Frame&)>& use) {
+bool forEachFrame(FrameSource& source, const std::string& stage, const ExperimentProgress& progress,
+                  const StopToken& stop, const std::function<void(const Frame&)>& use) {
   const size_t n = source.size();
   for (size_t i = 0; i < n; ++i) {
+    if (stop.stopRequested()) return false;
     const Frame frame = source.frame(i);
     if (frame.index != i)
       throw std::logic_error(source.info().name +
@@ -32,6 +33,12 @@ void forEachFrame(FrameSource& source, const std::string& stage, const Experimen
     use(frame);
     if (progress) progress(stage, i + 1, n);
   }
+  return true;
+}
+
+std::string partialNote() {
+  return "\nPartial: interrupted (Ctrl-C) before the end; these numbers cover only the frames "
+         "done.\n";
 }
 
 std::string countText(const std::optional<size_t>& n) {

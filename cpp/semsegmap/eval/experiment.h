@@ -9,6 +9,7 @@
 #include <string>
 
 #include "semsegmap/core/frame_source.h"
+#include "semsegmap/core/stop_token.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
@@ -33,8 +34,14 @@ using ExperimentProgress = std::function<void(const std::string& stage, size_t d
 // Renders (reads) every frame of `source` once and hands it to `use`, which feeds it to every
 // configuration compared; reports progress as `stage`. The experiments index their per-frame
 // records by frame number, so frames must come numbered from 0 in order (throws otherwise).
-void forEachFrame(FrameSource& source, const std::string& stage, const ExperimentProgress& progress,
-                  const std::function<void(const Frame&)>& use);
+// `stop` is checked before each frame, so a frame started is always finished: true when every
+// frame was used, false when the stop request ended the loop early (the experiment then reports
+// the frames done, marked interrupted).
+bool forEachFrame(FrameSource& source, const std::string& stage, const ExperimentProgress& progress,
+                  const StopToken& stop, const std::function<void(const Frame&)>& use);
+
+// The line a results table of an interrupted experiment ends with: its numbers are partial.
+std::string partialNote();
 
 // What a results table shows for a count or a mean error the run does not know (no ground
 // truth, no localization): "-", never a zero that would read as a measurement.

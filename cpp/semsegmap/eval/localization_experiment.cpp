@@ -18,18 +18,21 @@ namespace semsegmap {
 
 namespace {
 
-// The map run, rendered once for every configuration; each map is saved into out/maps/.
-std::vector<BuiltMap> buildMaps(const LocalizationExperimentConfig& cfg,
+// The map run, rendered once for every configuration; each map is saved into out/maps/ (when
+// interrupted, the map of the frames done: a whole map of a shorter run).
+std::vector<BuiltMap> buildMaps(LocalizationExperiment& e,
                                 const std::vector<std::shared_ptr<Describer>>& describers,
                                 const std::filesystem::path& out,
                                 const ExperimentProgress& progress) {
+  const LocalizationExperimentConfig& cfg = e.config;
   auto source = openDataset(simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset,
                                              cfg.max_frames, cfg.label_noise, cfg.rig));
   auto sessions =
       mappingSessions(cfg.configs, source->info(), describers, cfg.picture_points_per_segment);
-  forEachFrame(*source, "map " + cfg.map_run, progress, [&](const Frame& frame) {
-    for (auto& s : sessions) s->process(frame);
-  });
+  e.interrupted =
+      !forEachFrame(*source, "map " + cfg.map_run, progress, cfg.stop, [&](const Frame& frame) {
+        for (auto& s : sessions) s->process(frame);
+      });
   return finishMaps(sessions, cfg.configs, out);
 }
 
@@ -98,11 +101,13 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
   for (size_t c = 0; c < cfg.configs.size(); ++c)
     sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source->info(),
                                                              maps[c].map, describers[c]));
-  forEachFrame(*source, "localize " + run_name, progress, [&](const Frame& frame) {
-    for (auto& s : sessions) s->process(frame);
-  });
+  e.interrupted =
+      !forEachFrame(*source, "localize " + run_name, progress, cfg.stop, [&](const Frame& frame) {
+        for (auto& s : sessions) s->process(frame);
+      });
   for (size_t c = 0; c < cfg.configs.size(); ++c) {
-    const LocalizationRun run = sessions[c]->take();
+    LocalizationRun run = sessions[c]->take();
+    run.stats.interrupted = e.interrupted;  // its summary.json says the frames are those done
     LocalizationResult r = resultOf(e, cfg.configs[c], run_name, run, maps[c]);
     r.dataset = source->info().name;
     writeRunFiles(cfg, cfg.configs[c], run, maps[c], r, out);
@@ -134,10 +139,14 @@ nlohmann::ordered_json toJson(const LocalizationResult& r) {
           {"cumulative", r.cumulative}};
 }
 
-// The paper's accuracy figure: localizations within each error threshold, a panel per query run.
+// The paper's accuracy figure: localizations within each error threshold, a panel per query run
+// done (an interrupted experiment may not have run them all).
 std::vector<viz::Panel> accuracyPanels(const LocalizationExperiment& e) {
   std::vector<viz::Panel> panels;
   for (const std::string& run_name : e.config.query_runs) {
+    if (std::none_of(e.results.begin(), e.results.end(),
+                     [&](const LocalizationResult& r) { return r.run == run_name; }))
+      continue;
     viz::Panel p;
     p.title = run_name;
     p.xlabel = "translation error threshold (m)";
@@ -178,9 +187,11 @@ LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& 
   // Models load first: a missing one fails before minutes of simulation.
   std::vector<std::shared_ptr<Describer>> describers;
   for (const NamedConfig& c : cfg.configs) describers.push_back(makeDescriber(c.config.descriptor));
-  const std::vector<BuiltMap> maps = buildMaps(cfg, describers, out, progress);
-  for (const std::string& run_name : cfg.query_runs)
+  const std::vector<BuiltMap> maps = buildMaps(e, describers, out, progress);
+  for (const std::string& run_name : cfg.query_runs) {
+    if (e.interrupted) break;  // no run starts after the stop request
     localizeRun(e, run_name, describers, maps, out, progress);
+  }
   return e;
 }
 
@@ -196,6 +207,7 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
   j["wrong_m"] = e.config.wrong_m;
   j["recall_window_m"] = e.config.recall_window_m;
   j["thresholds_m"] = e.thresholds;
+  j["interrupted"] = e.interrupted;  // `results` are the query runs done before Ctrl-C
   j["results"] = nlohmann::ordered_json::array();
   for (const LocalizationResult& r : e.results) j["results"].push_back(toJson(r));
   return j;
@@ -204,6 +216,7 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
 void writeLocalizationFiles(const LocalizationExperiment& e, const std::filesystem::path& out) {
   std::filesystem::create_directories(out);
   writeJsonAtomically(out / "localization.json", toJson(e));
+  if (e.results.empty()) return;  // interrupted while mapping: no run to plot
   viz::plotPanels(out / "localization_accuracy.png",
                   "Localizations against the " + e.config.map_run + " map (world " +
                       std::to_string(e.config.world_seed) + ", " + e.config.preset + ")",
@@ -237,6 +250,7 @@ std::string localizationTable(const LocalizationExperiment& e) {
                   paper_n >= 0 ? std::to_string(paper_n).c_str() : "-");
     t << line;
   }
+  if (e.interrupted) t << partialNote();
   return t.str();
 }
 

@@ -33,6 +33,9 @@ struct LocalizationExperimentConfig {
   double wrong_m = 5.0;              // a localization farther off is wrong
   double recall_window_m = 20.0;
   size_t picture_points_per_segment = 32;  // kept in memory for the pictures, not saved
+  // Checked before each frame (Ctrl-C in the CLI): the run in hand ends with its frames done
+  // (a map of them, or that query run's results) and no further run starts.
+  StopToken stop;
 };
 
 struct LocalizationResult {  // one configuration on one query run
@@ -56,6 +59,9 @@ struct LocalizationExperiment {
   LocalizationExperimentConfig config;
   std::vector<LocalizationResult> results;  // query run major, then configuration
   std::vector<double> thresholds;           // of the cumulative curves, m
+  // LocalizationExperimentConfig::stop ended it early: `results` hold the query runs done, the
+  // last of them over its frames done (none when the stop came while mapping).
+  bool interrupted = false;
 };
 
 // Maps the map run and localizes the query runs with every configuration. What each run leaves
@@ -69,7 +75,7 @@ LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& 
 nlohmann::ordered_json toJson(const LocalizationExperiment& e);
 
 // Writes into `out` localization.json and localization_accuracy.png (the cumulative number of
-// localizations against the error threshold, one panel per query run).
+// localizations against the error threshold, one panel per query run; none without a run done).
 void writeLocalizationFiles(const LocalizationExperiment& e, const std::filesystem::path& out);
 
 // evaluateLocalization, then writeLocalizationFiles.

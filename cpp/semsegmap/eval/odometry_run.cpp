@@ -6,6 +6,7 @@
 
 #include "semsegmap/core/json.h"
 #include "semsegmap/io/trajectory_file.h"
+#include "semsegmap/outputs/run_output.h"
 #include "semsegmap/viz/trajectory_png.h"
 
 namespace semsegmap {
@@ -30,6 +31,7 @@ OdometryRun runLidarOdometry(FrameSource& source, const OdometryConfig& config, 
     const OdometryResult r = odometry.registerFrame(f.points, f.point_times, f.timestamp_s);
     run.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.frames.push_back(r);
+    run.stamps.push_back(stampOf(f, run.has_frame_times));
     run.trajectory.push_back({f.timestamp_s, baseOdometryFromLidar(r.T_odom_lidar, T_base_lidar)});
     all_ground_truth = all_ground_truth && f.T_world_base.has_value();
     if (f.T_world_base) run.ground_truth.push_back(*f.T_world_base);
@@ -100,6 +102,9 @@ void writeOdometryFiles(const std::filesystem::path& out, const OdometryRun& run
   std::filesystem::create_directories(out);
   if (run.has_frame_times) writeTum(out / "trajectory_tum.txt", run.trajectory);
   writeKitti(out / "trajectory_kitti.txt", run.trajectory);
+  // The frames as the dataset names them, beside the estimate (and the ground truth, if any).
+  writeTrajectoryCsv(out / "trajectory.csv", run.stamps,
+                     {{"odom", posesOf(run.trajectory)}, {"gt", run.ground_truth}});
   const std::optional<OdometryErrors> errors = odometryErrors(run);
   writeJsonAtomically(out / "summary.json", toJson(run, errors));
   if (!errors) return;

@@ -24,6 +24,7 @@ struct OdometryRun {
   std::vector<StampedPose> trajectory;  // T_odom_base per frame
   std::vector<OdometryResult> frames;   // the odometry's diagnostics per frame
   std::vector<Pose> ground_truth;       // T_world_base per frame, when every frame has it
+  std::vector<FrameStamp> stamps;       // per frame: the data's names (trajectory.csv)
   double seconds = 0.0;                 // in registerFrame only (not reading the data)
   bool interrupted = false;             // the stop request ended it early: `frames` are those done
   // The trajectory's times are the data's; false: made up from the rate
@@ -49,8 +50,9 @@ std::optional<OdometryErrors> odometryErrors(const OdometryRun& run);
 nlohmann::ordered_json toJson(const OdometryRun& run, const std::optional<OdometryErrors>& errors);
 
 // trajectory_tum.txt (only with the data's frame times: a made-up time would pair poses with the
-// wrong data), trajectory_kitti.txt, summary.json and, with ground truth, trajectory.png
-// (estimate against ground truth, from above) in `out`.
+// wrong data), trajectory_kitti.txt, trajectory.csv (frame, dataset_frame, timestamp, odom_*,
+// gt_*: outputs/run_output.h), summary.json and, with ground truth, trajectory.png (estimate
+// against ground truth, from above) in `out`.
 void writeOdometryFiles(const std::filesystem::path& out, const OdometryRun& run);
 
 }  // namespace semsegmap

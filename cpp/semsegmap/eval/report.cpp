@@ -133,7 +133,7 @@ std::string localizationSection(const LocalizationExperiment& e) {
        "Table I count for the same run and method.\n\n"
     << localizationTable(e) << "\n"
     << localizationVerdict(e) << "\n"
-    << "![accuracy](localization_accuracy.png)\n\n";
+    << (e.results.empty() ? "" : "![accuracy](localization_accuracy.png)\n\n");
   for (const LocalizationResult& res : e.results)
     r << "![" << res.dir.string() << "](" << res.dir.string() << "/localization.png)\n";
   r << "\n";
@@ -175,6 +175,9 @@ std::string paperReport(const ReportContext& c, const SegmentationExperiment* se
     << "The simulated world is not the paper's, so the paper's numbers are a reference for the "
        "direction and size of the differences, not for the counts themselves. SemSegMap and the "
        "SegMap baseline always run on the very same frames.\n\n";
+  if (c.interrupted)
+    r << "**Partial: interrupted (Ctrl-C).** The experiments below cover only the frames done "
+         "before the interruption; an experiment that had not started is missing.\n\n";
   for (const std::string& p : c.pictures) r << "![" << p << "](" << p << ")\n\n";
   if (!c.view.empty())
     r << "In 3D: [" << c.view << "](" << c.view

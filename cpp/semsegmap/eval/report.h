@@ -18,6 +18,9 @@ struct ReportContext {
   double seconds = 0.0;
   std::vector<std::string> pictures;  // extra pictures (relative paths) shown first
   std::string view;                   // a page of `semsegmap view` (relative path), linked first
+  // Ctrl-C ended the experiments early: the report says its numbers are partial, and an
+  // experiment that did not start is left out.
+  bool interrupted = false;
 };
 
 // The commit of the working directory's repository ("unknown" outside one; "+changes" when it

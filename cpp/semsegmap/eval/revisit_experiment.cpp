@@ -69,15 +69,16 @@ void checkRevisitInput(const FrameSource& source, const RevisitExperimentConfig&
 
 // The map frames, read once for every configuration, on ground-truth poses; their ground-truth
 // positions go to `mapped_positions`.
-std::vector<BuiltMap> buildMaps(FrameSource& source, const RevisitExperimentConfig& cfg,
+std::vector<BuiltMap> buildMaps(FrameSource& source, RevisitExperiment& e,
                                 const std::vector<std::shared_ptr<Describer>>& describers,
                                 const std::filesystem::path& out,
                                 std::vector<Eigen::Vector3d>& mapped_positions,
                                 const ExperimentProgress& progress, GroundTruthCheck* check) {
+  const RevisitExperimentConfig& cfg = e.config;
   FrameSubset frames(source, framesOf(cfg.map_frames));
   auto sessions =
       mappingSessions(cfg.configs, source.info(), describers, cfg.picture_points_per_segment);
-  forEachFrame(frames, "map", progress, [&](const Frame& frame) {
+  e.interrupted = !forEachFrame(frames, "map", progress, cfg.stop, [&](const Frame& frame) {
     if (!frame.T_world_base)
       throw std::runtime_error(source.info().name + ": frame " +
                                std::to_string(frames.datasetFrame(frame.index)) +
@@ -107,6 +108,7 @@ std::vector<WakeUp> wakeUpsOf(const RevisitExperiment& e,
     w.frames = session.front();
     const auto q = std::find_if(e.queries.begin(), e.queries.end(),
                                 [&](const RevisitFrame& f) { return f.frame == w.frames.first; });
+    if (q == e.queries.end()) continue;  // a session the stop request left unread
     w.revisit = q != e.queries.end() && q->revisit;
     for (const RevisitLocalization& l : localizations) {
       if (l.frame < w.frames.first || l.frame > w.frames.last) continue;
@@ -232,12 +234,13 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
   const RevisitExperimentConfig& cfg = e.config;
   std::vector<LocalizationRun> runs(cfg.configs.size());
   for (const std::vector<FrameRange>& ranges : querySessions(cfg)) {
+    if (e.interrupted) break;  // no session starts after the stop request
     FrameSubset frames(source, framesOf(ranges));
     std::vector<std::unique_ptr<LocalizationSession>> sessions;
     for (size_t c = 0; c < cfg.configs.size(); ++c)
       sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source.info(),
                                                                maps[c].map, describers[c]));
-    forEachFrame(frames, "localize", progress, [&](const Frame& frame) {
+    e.interrupted = !forEachFrame(frames, "localize", progress, cfg.stop, [&](const Frame& frame) {
       noteQuery(e, frames.datasetFrame(frame.index), frame, mapped_positions,
                 source.info().rig.T_base_lidar, check);
       for (auto& s : sessions) s->process(frame);
@@ -252,6 +255,7 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
   }
   summarizeCorrections(e);
   for (size_t c = 0; c < cfg.configs.size(); ++c) {
+    runs[c].stats.interrupted = e.interrupted;  // its summary.json says so
     e.results.push_back(resultOf(e, cfg.configs[c], runs[c], maps[c]));
     writeRunFiles(cfg.configs[c], runs[c], maps[c], e, out);
   }
@@ -436,7 +440,7 @@ RevisitExperiment evaluateRevisits(FrameSource& source, const RevisitExperimentC
   if (cfg.check_ground_truth) check.emplace();
   GroundTruthCheck* checking = check ? &*check : nullptr;
   const std::vector<BuiltMap> maps =
-      buildMaps(source, cfg, describers, out, mapped_positions, progress, checking);
+      buildMaps(source, e, describers, out, mapped_positions, progress, checking);
   localizeQueries(source, e, describers, maps, mapped_positions, out, progress, checking);
   for (size_t c = 0; c < e.results.size(); ++c) {
     e.results[c].model = choices[c].descriptor.model;
@@ -448,6 +452,7 @@ RevisitExperiment evaluateRevisits(FrameSource& source, const RevisitExperimentC
 nlohmann::ordered_json toJson(const RevisitExperiment& e) {
   nlohmann::ordered_json j;
   j["dataset"] = e.dataset;
+  j["interrupted"] = e.interrupted;  // `queries` are those done before Ctrl-C
   auto ranges = [](const std::vector<FrameRange>& rs) {
     nlohmann::ordered_json a = nlohmann::ordered_json::array();
     for (const FrameRange& r : rs) a.push_back({r.first, r.last});
@@ -534,6 +539,7 @@ std::string revisitTable(const RevisitExperiment& e) {
   }
   for (const RevisitResult& r : e.results)
     if (!r.model_note.empty()) t << "\n" << r.config << ": " << r.model_note << "\n";
+  if (e.interrupted) t << partialNote();
   return t.str();
 }
 

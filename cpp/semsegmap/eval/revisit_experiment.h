@@ -42,6 +42,9 @@ struct RevisitExperimentConfig {
   // (eval/ground_truth_check.h): how far the ground truth disagrees with the map's own geometry,
   // and each localization's error against the registered pose besides the recorded one.
   bool check_ground_truth = false;
+  // Checked before each frame (Ctrl-C in the CLI): the maps and query sessions end with the
+  // frames done, and no further query session starts.
+  StopToken stop;
 };
 
 // "N[/EVERY]" of --wake-up; throws std::invalid_argument naming `what` and the text.
@@ -105,6 +108,7 @@ struct RevisitExperiment {
   double mean_correction_m = 0.0, max_correction_m = 0.0;
   std::vector<RevisitResult> results;
   std::vector<double> thresholds;  // of the cumulative curves, m
+  bool interrupted = false;        // the stop request ended it early: `queries` are those done
 };
 
 // Checks the ranges against the dataset and each other, and that it has ground truth, before any

@@ -65,6 +65,7 @@ std::vector<double> revisitIous(const std::vector<FinishedSegment>& segments,
 struct SegmentedRun {
   std::vector<std::vector<FinishedSegment>> finished;  // per configuration
   std::vector<Pose> trajectory;                        // one pose per frame
+  bool interrupted = false;                            // the frames done, not all of them
 };
 
 SegmentedRun segmentRun(const SegmentationExperimentConfig& cfg,
@@ -76,12 +77,13 @@ SegmentedRun segmentRun(const SegmentationExperimentConfig& cfg,
         std::make_unique<Pipeline>(c.config, source->info(), PoseSource::kGroundTruth));
   SegmentedRun run;
   run.finished.resize(cfg.configs.size());
-  forEachFrame(*source, "segment " + cfg.run, progress, [&](const Frame& frame) {
-    for (size_t c = 0; c < pipelines.size(); ++c)
-      for (const Segment& s : pipelines[c]->process(frame).segmentation.finished)
-        run.finished[c].push_back(finishedSegment(s));
-    run.trajectory.push_back(*frame.T_world_base);
-  });
+  run.interrupted =
+      !forEachFrame(*source, "segment " + cfg.run, progress, cfg.stop, [&](const Frame& frame) {
+        for (size_t c = 0; c < pipelines.size(); ++c)
+          for (const Segment& s : pipelines[c]->process(frame).segmentation.finished)
+            run.finished[c].push_back(finishedSegment(s));
+        run.trajectory.push_back(*frame.T_world_base);
+      });
   for (size_t c = 0; c < pipelines.size(); ++c)
     for (const Segment& s : pipelines[c]->finish()) run.finished[c].push_back(finishedSegment(s));
   return run;
@@ -185,6 +187,7 @@ SegmentationExperiment evaluateSegmentation(const SegmentationExperimentConfig& 
   e.config = cfg;
   const SegmentedRun run = segmentRun(cfg, progress);
   e.frames = run.trajectory.size();
+  e.interrupted = run.interrupted;
   const std::vector<double> travelled = travelledDistances(run.trajectory);
   for (size_t c = 0; c < cfg.configs.size(); ++c) {
     e.results.push_back(
@@ -201,6 +204,7 @@ nlohmann::ordered_json toJson(const SegmentationExperiment& e) {
   j["preset"] = e.config.preset;
   j["run"] = e.config.run;
   j["frames"] = e.frames;
+  j["interrupted"] = e.interrupted;  // `frames` are those done before Ctrl-C
   j["consistent_iou"] = e.config.consistent_iou;
   j["bins"] = e.config.bins;
   j["results"] = nlohmann::ordered_json::array();
@@ -253,6 +257,7 @@ std::string segmentationTable(const SegmentationExperiment& e) {
                   e.inconsistent_change_pct);
     t << line;
   }
+  if (e.interrupted) t << partialNote();
   return t.str();
 }
 

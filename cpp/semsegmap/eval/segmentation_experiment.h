@@ -27,7 +27,8 @@ struct SegmentationExperimentConfig {
   double revisit_radius_m = 20.0;
   double candidate_radius_m = 5.0;  // target segments with a centroid this close are compared
   double consistent_iou = 0.33;
-  int bins = 10;  // of width 1 / bins over [0, 1]
+  int bins = 10;   // of width 1 / bins over [0, 1]
+  StopToken stop;  // checked before each frame (Ctrl-C in the CLI): the frames done are compared
 };
 
 struct SegmentationResult {
@@ -47,6 +48,7 @@ struct SegmentationExperiment {
   // none): per bin, consistent and inconsistent. The paper: +30.97 % and -24.24 %.
   std::vector<double> bin_change_pct;
   double consistent_change_pct = 0.0, inconsistent_change_pct = 0.0;
+  bool interrupted = false;  // the stop request ended the run early: `frames` are those done
 };
 
 // Histogram of IoU values in `bins` equal bins over [0, 1].

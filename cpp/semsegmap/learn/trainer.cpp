@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 namespace semsegmap {
@@ -317,11 +318,14 @@ class Training {
     steps_ = std::max<size_t>(1, anchors_per_epoch / batch_);
   }
 
-  EpochStats epoch(int epoch, const TrainCallbacks& callbacks) {
+  // Nothing when the stop request came before the epoch's last step: an epoch half trained is
+  // neither validated nor kept.
+  std::optional<EpochStats> epoch(int epoch, const TrainCallbacks& callbacks) {
     const auto t0 = std::chrono::steady_clock::now();
     const bool mine = epoch > config_.warmup_epochs;
     Mean loss_mean, triplet_mean, recon_mean, distillation_mean;
     for (size_t step = 0; step < steps_; ++step) {
+      if (callbacks.stop.stopRequested()) return std::nullopt;
       const std::vector<Triplet> triplets = sampleTriplets(mine);
       // A teacher of weight 0 only gave the starting weights: its descriptors are not needed.
       DescriptorNetImpl* teacher = config_.distillation_weight > 0 ? teacher_.get() : nullptr;
@@ -439,7 +443,12 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
   Snapshot best;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int epoch = 1; epoch <= config.epochs; ++epoch) {
-    EpochStats stats = training.epoch(epoch, callbacks);
+    std::optional<EpochStats> done = training.epoch(epoch, callbacks);
+    if (!done) {
+      result.interrupted = true;
+      break;
+    }
+    EpochStats& stats = *done;
     // Without validation queries (tiny data), the training loss is all there is to go by.
     const double score = stats.validation.queries > 0 ? stats.validation.top1 : -stats.loss;
     if (score > best_score) {
@@ -453,6 +462,7 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
     if (callbacks.epoch) callbacks.epoch(stats);
     training.decayLearningRate();
   }
+  if (result.history.empty()) return result;  // interrupted in the first epoch: no model
   best.restore(training.net());
   result.net = training.sharedNet();
   return result;

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "semsegmap/core/stop_token.h"
 #include "semsegmap/describe/learned_net.h"
 #include "semsegmap/learn/augment.h"
 #include "semsegmap/learn/training_data.h"
@@ -75,10 +76,14 @@ struct EpochStats {
 };
 
 struct TrainResult {
-  std::shared_ptr<DescriptorNetImpl> net;  // with the weights of the best epoch
-  std::vector<EpochStats> history;
+  // With the weights of the best epoch; null when interrupted before the first epoch ended.
+  std::shared_ptr<DescriptorNetImpl> net;
+  std::vector<EpochStats> history;  // the epochs completed
   int best_epoch = 0;
   size_t train_observations = 0, validation_observations = 0, anchors = 0;
+  // TrainCallbacks::stop ended training early: the epoch in hand was dropped unvalidated, and
+  // `net` is the best of the epochs completed.
+  bool interrupted = false;
 };
 
 struct TrainCallbacks {
@@ -87,6 +92,9 @@ struct TrainCallbacks {
   std::function<void(const EpochStats&)> epoch;
   // Each time the best epoch improves, with the network in that state (e.g. to save it).
   std::function<void(DescriptorNetImpl&)> best;
+  // Checked before each step (Ctrl-C in the CLI): a step started always finishes, the partial
+  // epoch is dropped and training ends (TrainResult::interrupted).
+  StopToken stop;
 };
 
 // Trains a new network on `data`. The best epoch is the one of highest validation top-1 (the

@@ -95,6 +95,10 @@ void appendObservations(FrameSource& source, uint16_t source_index, PipelineConf
   Pipeline pipe(pipeline, info, PoseSource::kGroundTruth);
   const size_t n = framesToRead(source, config.max_frames);
   for (size_t i = 0; i < n; ++i) {
+    if (config.stop.stopRequested()) {
+      out.interrupted = true;
+      break;  // the segments of the frames done still finish below
+    }
     FrameResult r = pipe.process(source.frame(i));
     for (const Segment& s : r.segmentation.finished)
       appendSegment(s, source_index, config, info.first_transient_instance, out);

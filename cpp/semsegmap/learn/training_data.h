@@ -14,6 +14,7 @@
 
 #include "semsegmap/core/enriched_point.h"
 #include "semsegmap/core/frame_source.h"
+#include "semsegmap/core/stop_token.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
 namespace semsegmap {
@@ -44,6 +45,9 @@ struct TrainingSet {
   // unrelated objects. A missing entry means the source's own world.
   std::vector<std::string> source_worlds;
   std::vector<TrainingObservation> observations;
+  // ExtractionConfig::stop ended the extraction early: the observations of the frames done, a
+  // set that must not be cached as the whole one.
+  bool interrupted = false;
 };
 
 struct ExtractionConfig {
@@ -56,6 +60,9 @@ struct ExtractionConfig {
   // most a few thousand points anyway (semsegmap-net subsamples to NetConfig::num_points).
   size_t max_points_per_observation = 4096;
   uint64_t seed = 1;
+  // Checked before each frame (Ctrl-C in the CLI): once asked, no further frame or dataset is
+  // read and the set is marked interrupted. Not part of what the set is made from.
+  StopToken stop;
 };
 
 // Called after each frame with (frames done, frames in this dataset, dataset index).

@@ -13,15 +13,6 @@ namespace semsegmap {
 
 namespace {
 
-// ",x,y,z,qx,qy,qz,qw" with the precision of localizations.csv.
-std::string poseFields(const Pose& T) {
-  const auto v = toXyzQuat(T);
-  char s[160];
-  std::snprintf(s, sizeof(s), ",%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f", v[0], v[1], v[2], v[3], v[4],
-                v[5], v[6]);
-  return s;
-}
-
 void writeMatchesCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
     out << "frame,local_x,local_y,local_z,target_x,target_y,target_z\n";
@@ -32,24 +23,6 @@ void writeMatchesCsv(const std::filesystem::path& path, const LocalizationRun& r
                       local.x(), local.y(), local.z(), target.x(), target.y(), target.z());
         out << line;
       }
-  });
-}
-
-// Frames are numbered from 0 in the order they are run (the localization records carry the
-// same numbers), so row i is frame i; beside it the dataset's own number and time, as in
-// localizations.csv.
-void writeTrajectoryCsv(const std::filesystem::path& path, const LocalizationRun& run) {
-  const bool gt = run.trajectory_gt.size() == run.trajectory_odom.size();
-  const bool named = run.frames.size() == run.trajectory_odom.size();
-  writeFileAtomically(path, [&](std::ostream& out) {
-    out << "frame,dataset_frame,timestamp";
-    for (const char* who : {"odom", "gt"})
-      for (const char* f : {"x", "y", "z", "qx", "qy", "qz", "qw"}) out << ',' << who << '_' << f;
-    out << '\n';
-    for (size_t i = 0; i < run.trajectory_odom.size(); ++i)
-      out << i << (named ? frameStampFields(run.frames[i].number, run.frames[i].time_s) : ",,")
-          << poseFields(run.trajectory_odom[i])
-          << (gt ? poseFields(run.trajectory_gt[i]) : ",,,,,,,") << '\n';
   });
 }
 
@@ -145,7 +118,11 @@ void readSummary(const std::filesystem::path& path, LocalizationFolder& f) {
 
 void writeLocalizationDetails(const std::filesystem::path& dir, const LocalizationRun& run) {
   writeMatchesCsv(dir / "matches.csv", run);
-  writeTrajectoryCsv(dir / "trajectory.csv", run);
+  // Frames are numbered from 0 in the order they are run (the localization records carry the
+  // same numbers), so row i is frame i; beside it the dataset's own number and time, as in
+  // localizations.csv.
+  writeTrajectoryCsv(dir / "trajectory.csv", run.frames,
+                     {{"odom", run.trajectory_odom}, {"gt", run.trajectory_gt}});
 }
 
 LocalizationFolder readLocalizationFolder(const std::filesystem::path& dir) {

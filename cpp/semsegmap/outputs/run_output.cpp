@@ -25,6 +25,46 @@ std::string frameStampFields(const std::optional<size_t>& number,
   return fields;
 }
 
+namespace {
+
+// ",x,y,z,qx,qy,qz,qw" with the precision of localizations.csv; commas alone without a pose.
+std::string poseFields(const std::optional<Pose>& T) {
+  if (!T) return ",,,,,,,";
+  const auto v = toXyzQuat(*T);
+  char s[160];
+  std::snprintf(s, sizeof(s), ",%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f", v[0], v[1], v[2], v[3], v[4],
+                v[5], v[6]);
+  return s;
+}
+
+}  // namespace
+
+void writeTrajectoryCsv(const std::filesystem::path& path, const std::vector<FrameStamp>& frames,
+                        const std::vector<TrajectoryColumns>& columns) {
+  const size_t rows = columns.empty() ? 0 : columns.front().poses.size();
+  const bool named = frames.size() == rows;
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "frame,dataset_frame,timestamp";
+    for (const TrajectoryColumns& c : columns)
+      for (const char* f : {"x", "y", "z", "qx", "qy", "qz", "qw"})
+        out << ',' << c.prefix << '_' << f;
+    out << '\n';
+    for (size_t i = 0; i < rows; ++i) {
+      out << i << (named ? frameStampFields(frames[i].number, frames[i].time_s) : ",,");
+      for (const TrajectoryColumns& c : columns)
+        out << poseFields(c.poses.size() == rows ? std::optional<Pose>(c.poses[i]) : std::nullopt);
+      out << '\n';
+    }
+  });
+}
+
+void writeTrajectoryCsv(const std::filesystem::path& path, const SlamRun& run) {
+  writeTrajectoryCsv(path, run.frames,
+                     {{"slam", posesOf(run.trajectory)},
+                      {"odom", posesOf(run.trajectory_odom)},
+                      {"gt", run.trajectory_gt}});
+}
+
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
     // The columns of schema semsegmap.localization/2 (summary.json; docs/commands.md), read by

@@ -34,6 +34,21 @@ void writeLocalizationsCsv(const std::filesystem::path& path, const Localization
 std::string frameStampFields(const std::optional<size_t>& number,
                              const std::optional<double>& time_s);
 
+// One group of pose columns of trajectory.csv: <prefix>_x/y/z/qx/qy/qz/qw, one pose per frame
+// run, or empty fields on every row when `poses` is empty (a run without ground truth).
+struct TrajectoryColumns {
+  std::string prefix;  // "odom", "gt", "slam"
+  std::vector<Pose> poses;
+};
+// trajectory.csv, one row per pose of the first group: frame (the run's index), dataset_frame
+// and timestamp (frameStampFields: the data's own name and time, empty where it has none, and on
+// every row unless `frames` has one per row), then each group's columns. The one layout of
+// localize's, slam's and odometry's (an atomic write).
+void writeTrajectoryCsv(const std::filesystem::path& path, const std::vector<FrameStamp>& frames,
+                        const std::vector<TrajectoryColumns>& columns);
+// slam's: slam_* (loop-closed T_map_base), odom_* (T_odom_base) and gt_* (T_world_base).
+void writeTrajectoryCsv(const std::filesystem::path& path, const SlamRun& run);
+
 // The mean time per frame of each stage.
 StageTimes meanStageTimes(const RunStats& stats);
 // {"enrich", "local_map", "segment", "describe", "localize"} in ms, and "total" when asked.

@@ -86,6 +86,7 @@ class SlamSession {
     }
     odom_.push_back(T_odom_base);
     stamps_.push_back(frame.timestamp_s);
+    run_.frames.push_back(stampOf(frame, run_.has_frame_times));
     frame_indices_.push_back(frame.index);
     if (frame.T_world_base) run_.trajectory_gt.push_back(*frame.T_world_base);
   }

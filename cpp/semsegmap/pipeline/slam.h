@@ -24,6 +24,7 @@ struct SlamRun {
   std::vector<StampedPose> trajectory;       // optimized, one pose per frame
   std::vector<StampedPose> trajectory_odom;  // odometry only (the initial estimate)
   std::vector<Pose> trajectory_gt;           // empty without ground truth
+  std::vector<FrameStamp> frames;            // per frame run: the data's names (trajectory.csv)
   std::vector<LoopClosure> loops;
   TargetMap map;  // the segments at their corrected positions (duplicates removed)
   RunStats stats;
