@@ -147,7 +147,7 @@ void bindResults(py::module_& m) {
                     "a stop request (StopFlag, Ctrl-C) ended the run early: `frames` are those "
                     "done")
       .def_property_readonly("fps", &RunStats::fps);
-  defRepr(stats, "RunStats", {"frames", "fps", "interrupted"});
+  defRepr(stats, "RunStats", {"frames", "fps"});
   py::class_<StopFlag>(m, "StopFlag",
                        "A request to stop a run between frames: pass it as stop= to run_mapping "
                        "or run_localization and set() it, e.g. from another thread; the run "
