@@ -2,21 +2,71 @@
 """Writes a results table of docs/results.md from the eval commands' JSON, so that rerunning the
 commands regenerates the numbers instead of someone copying them by hand.
 
-    scripts/write_results.py SECTION LABEL=DIR/localization.json [LABEL=...] [--doc FILE]
+    scripts/write_results.py SECTION INPUT [INPUT...] [--table KIND] [--doc FILE]
 
-Each LABEL=FILE is the localization.json of one `semsegmap eval localization` run (LABEL names
-its rig in the table). The table replaces what stands between the lines
-`<!-- results:SECTION -->` and `<!-- /results:SECTION -->` of the document; a missing section is
-an error naming the document, so that a typo never appends a second table. The document is
-written to a temporary name and renamed, so an interrupted run leaves the old one whole.
+The table replaces what stands between the lines `<!-- results:SECTION -->` and
+`<!-- /results:SECTION -->` of the document; a missing section is an error naming the document,
+so that a typo never appends a second table. The document is written to a temporary name and
+renamed, so an interrupted run leaves the old one whole. KIND says what the inputs are:
+
+  rigs          LABEL=localization.json ...: a row per run and config, LABEL names the rig
+  runs          localization.json ...: the same without the rig (the demo's table)
+  table-i       localization.json of `eval localization|paper`: the paper's Table I
+  configs       localization.json with many --configs: within 1 m per run, a row per config
+  label-noise   LEVEL=localization.json ...: within 1 m per run and config, a row per level
+  segmentation  segmentation.json of `eval segmentation|paper`
+  descriptors   descriptors.json of `eval descriptors|paper`
+  benchmarks    Google Benchmark JSON (`semsegmap_bench --benchmark_out=FILE`)
+  memory        LABEL=rss.csv of `semsegmap_memory_run`: the resident set per kilometre
+  segments      LABEL=segments.csv of `semsegmap segment`: count, size and purity
+  odometry      LABEL=summary.json of `semsegmap odometry`: KITTI errors and ATE
+  revisits      revisits.json of `semsegmap eval revisits`: a row per config
+  wake-ups      revisits.json of `eval revisits --wake-up`: localized by frame N
+  registration  Google Benchmark JSON: the odometry's registration against the libraries'
+  slam          LABEL=summary.json of `semsegmap slam`: loop closures and trajectory errors
 """
 import argparse
+import csv
 import json
 import os
+import re
 import sys
 
-HEADER = ("| rig | run | config | localizations | < 1 m | wrong (> 5 m) | mean error "
-          "| recall (20 m) |\n| --- | --- | --- | ---: | ---: | ---: | --- | ---: |\n")
+# The paper's Table I (localizations of SegMap and SemSegMap on its S2 and S3): the reference the
+# simulator's counts are shown beside, not a measurement of ours.
+PAPER_TABLE_I = {("S2", "segmap"): 126, ("S2", "semsegmap"): 258, ("S3", "segmap"): 10,
+                 ("S3", "semsegmap"): 108}
+
+
+def fail(message):
+    sys.exit(message)
+
+
+def load_json(path, needed, what):
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except (OSError, ValueError) as e:
+        fail(f"{path}: cannot read {what}: {e}")
+    if needed not in data:
+        fail(f"{path}: not {what} (no {needed})")
+    return data
+
+
+def load_localization(path):
+    return load_json(path, "results", "a localization.json of semsegmap eval localization")
+
+
+def labelled(inputs):
+    """LABEL=FILE arguments as (label, file) pairs."""
+    out = []
+    for run in inputs:
+        # The file is after the last "=": a label may hold one ("sweep=1, deskewed").
+        label, sep, path = run.rpartition("=")
+        if not sep or not label or not path:
+            fail(f"expected LABEL=FILE, got '{run}'")
+        out.append((label, path))
+    return out
 
 
 def shown(value):
@@ -24,56 +74,370 @@ def shown(value):
     return "-" if value is None else value
 
 
-def rows(label, path):
-    try:
-        with open(path, encoding="utf-8") as f:
-            experiment = json.load(f)
-    except (OSError, ValueError) as e:
-        sys.exit(f"{path}: cannot read the localization results: {e}")
-    if "results" not in experiment:
-        sys.exit(f"{path}: not a localization.json of semsegmap eval localization (no results)")
-    out = []
-    for r in experiment["results"]:
-        # Unknown values (no localization, no ground truth) are null: shown as "-", never 0.
-        translation, rotation = r.get("mean_translation_error_m"), r.get("mean_rotation_error_deg")
-        error = (f"{translation:.2f} m / {rotation:.2f} deg"
-                 if r["n_localizations"] and translation is not None and rotation is not None
-                 else "-")
-        below_1m = shown(r.get("n_error_below_1m"))
-        out.append(f"| {label} | {r['run']} | {r['config']} | {r['n_localizations']} "
-                   f"| {below_1m} | {r['n_wrong']} | {error} "
-                   f"| {r['recall_along_trajectory']:.2f} |\n")
-    return out
+def mean_error(r, sep=" / "):
+    # Unknown values (no localization, no ground truth) are null: shown as "-", never 0.
+    translation, rotation = r.get("mean_translation_error_m"), r.get("mean_rotation_error_deg")
+    if not r["n_localizations"] or translation is None or rotation is None:
+        return "-"
+    return f"{translation:.2f} m{sep}{rotation:.2f} deg"
 
 
-def replace_section(text, section, table, doc):
+def table(header, rows):
+    """A markdown table: header is a list of (title, right-aligned)."""
+    out = "| " + " | ".join(t for t, _ in header) + " |\n"
+    out += "| " + " | ".join("---:" if right else "---" for _, right in header) + " |\n"
+    return out + "".join("| " + " | ".join(str(c) for c in row) + " |\n" for row in rows)
+
+
+def rigs_table(inputs):
+    header = [("rig", 0), ("run", 0), ("config", 0), ("localizations", 1), ("< 1 m", 1),
+              ("wrong (> 5 m)", 1), ("mean error", 0), ("recall (20 m)", 1)]
+    rows = []
+    for label, path in labelled(inputs):
+        for r in load_localization(path)["results"]:
+            rows.append([label, r["run"], r["config"], r["n_localizations"],
+                         shown(r.get("n_error_below_1m")), r["n_wrong"], mean_error(r),
+                         f"{r['recall_along_trajectory']:.2f}"])
+    return table(header, rows)
+
+
+def runs_table(inputs):
+    header = [("run", 0), ("config", 0), ("localizations", 1), ("< 1 m", 1),
+              ("wrong (> 5 m)", 1), ("mean error", 0), ("recall (20 m)", 1)]
+    rows = [[r["run"], r["config"], r["n_localizations"], shown(r.get("n_error_below_1m")),
+             r["n_wrong"], mean_error(r), f"{r['recall_along_trajectory']:.2f}"]
+            for path in inputs for r in load_localization(path)["results"]]
+    return table(header, rows)
+
+
+def table_i(inputs):
+    header = [("run", 0), ("config", 0), ("localizations", 1), ("< 1 m", 1), ("< 5 m", 1),
+              ("wrong", 1), ("mean error", 0), ("recall", 1), ("map", 1), ("paper", 1)]
+    rows = []
+    for path in inputs:
+        for r in load_localization(path)["results"]:
+            paper = PAPER_TABLE_I.get((r["run"], r["config"]), "")
+            run = f"{r['run']} ({r['frames']} frames)"
+            kib = r["map_bytes"] / 1024
+            rows.append([run, r["config"], r["n_localizations"], shown(r.get("n_error_below_1m")),
+                         shown(r.get("n_error_below_5m")), r["n_wrong"], mean_error(r, ", "),
+                         f"{r['recall_along_trajectory']:.2f}",
+                         f"{r['map_segments']} segments, {kib:.1f} KiB", paper])
+    return table(header, rows)
+
+
+def configs_table(inputs):
+    """A row per config (and odometry, when the inputs' differ): within 1 m and the mean error
+    per run, the wrong ones and the recall of all runs."""
+    experiments = [load_localization(path) for path in inputs]
+    odometry_differs = len({e.get("query_odometry") for e in experiments}) > 1
+    rows, runs = [], []
+    for e in experiments:
+        configs = {}
+        for r in e["results"]:
+            configs.setdefault(r["config"], {})[r["run"]] = r
+        for config, per_run in configs.items():
+            runs = runs or list(per_run)
+            label = f"{config}, {e.get('query_odometry')} odometry" if odometry_differs else config
+            cells = []
+            for run in runs:
+                r = per_run.get(run)
+                cells += ([shown(r.get("n_error_below_1m")), mean_error(r)] if r else ["-", "-"])
+            wrong = sum(r["n_wrong"] for r in per_run.values())
+            recall = " / ".join(f"{per_run[run]['recall_along_trajectory']:.2f}"
+                                for run in runs if run in per_run)
+            rows.append([label, *cells, wrong, recall])
+    header = [("configuration", 0)]
+    for run in runs:
+        header += [(f"{run} < 1 m", 1), (f"{run} mean error", 0)]
+    return table(header + [("wrong", 1), ("recall " + " / ".join(runs), 1)], rows)
+
+
+def label_noise_table(inputs):
+    rows, columns = [], []
+    for level, path in labelled(inputs):
+        results = load_localization(path)["results"]
+        columns = columns or [(r["run"], r["config"]) for r in results]
+        found = {(r["run"], r["config"]): r for r in results}
+        cells = [shown(found[c].get("n_error_below_1m")) if c in found else "-" for c in columns]
+        wrong = sum(r["n_wrong"] for r in results)
+        rows.append([level, *cells, wrong])
+    header = ([("label noise", 1)] + [(f"{run} {config}", 1) for run, config in columns] +
+              [("wrong", 1)])
+    return table(header, rows)
+
+
+def segmentation_table(inputs):
+    header = [("config", 0), ("segments", 1), ("at revisits", 1), ("IoU >= 0.33", 1),
+              ("IoU < 0.33", 1)]
+    rows = []
+    for path in inputs:
+        e = load_json(path, "results", "a segmentation.json of semsegmap eval segmentation")
+        for r in e["results"]:
+            seen = r["revisit_segments"]
+            share = f" ({100 * r['consistent'] / seen:.0f} %)" if seen else ""
+            rows.append([r["config"], r["segments"], seen, f"{r['consistent']}{share}",
+                         r["inconsistent"]])
+        if len(inputs) == 1 and len(e["results"]) == 2:
+            paper = e.get("paper", {})
+            rows.append([f"change ({e['results'][0]['config']} vs {e['results'][1]['config']})",
+                         "", "",
+                         f"{e['consistent_change_pct']:+.1f} % "
+                         f"(paper {paper.get('consistent_change_pct', 0):+.2f} %)",
+                         f"{e['inconsistent_change_pct']:+.1f} % "
+                         f"(paper {paper.get('inconsistent_change_pct', 0):+.2f} %)"])
+    return table(header, rows)
+
+
+def descriptors_table(inputs):
+    rows, bands = [], []
+    for path in inputs:
+        e = load_json(path, "descriptors", "a descriptors.json of semsegmap eval descriptors")
+        bands = e["bands"]
+        for d in e["descriptors"]:
+            # A band's curve holds the share found within k = 1, 2, ...: its 16th entry is top-16.
+            per_band = [f"{c[min(15, len(c) - 1)]:.3f}" if c else "-" for c in d["band_curves"]]
+            rows.append([f"`{d['name']}`", f"{d['top1']:.3f}", f"{d['top16']:.3f}", *per_band,
+                         f"{d['segments_per_second']:.0f}"])
+    header = ([("descriptor", 0), ("top-1", 1), ("top-16", 1)] +
+              [(f"top-16 {band}", 1) for band in bands] + [("segments/s", 1)])
+    return table(header, rows)
+
+
+# What each benchmark measures and the target it is held to (the brief's, or none), in the order
+# of the table. A benchmark of the JSON that is not listed here is left out.
+BENCHMARKS = [
+    ("BM_SimulateFrame", "simulator frame: LiDAR 1920 x 64 + 3 cameras 640 x 480, full world",
+     "<= 150 ms", "ms"),
+    ("BM_Lidar", "of which the LiDAR sweep", "", "ms"),
+    ("BM_Enrich", "semantic enrichment, simulated rig, 3 cameras", "", "ms"),
+    ("BM_LocalMapAndSegmentation/0", "local map + incremental segmentation per S2 frame, "
+     "ground-truth poses, SemSegMap config", "<= 20 ms", "ms"),
+    ("BM_LocalMapAndSegmentation/1", "the same, SegMap config", "<= 20 ms", "ms"),
+    ("BM_PipelineFrontEnd", "the same inside the pipeline on drifting odometry", "<= 20 ms",
+     "ms"),
+    ("BM_LearnedDescribe/3/2", "descriptor inference, batches of 256, 2 threads: semsegmap-net",
+     ">= 300 segments/s", "items"),
+    ("BM_LearnedDescribe/2/2", "the same, segmap-cnn", ">= 1000 segments/s", "items"),
+    ("BM_WholePipeline/0/-1", "whole pipeline per S2 frame while localizing, SemSegMap",
+     ">= 20 Hz", "Hz"),
+    ("BM_WholePipeline/1/-1", "the same, SegMap", ">= 20 Hz", "Hz"),
+    ("BM_SegmentationNetwork/1", "camera segmentation network, one 640x480 picture, 1 thread",
+     "", "ms"),
+    ("BM_SegmentationNetwork/2", "the same, 2 threads", "", "ms"),
+    ("BM_WholePipeline/0/0", "whole pipeline with the network on every picture", "", "Hz"),
+    ("BM_WholePipeline/0/2", "the same, the network at 2 Hz per camera", "", "Hz"),
+    ("BM_OdometryOurs", "LiDAR odometry, KITTI HDL-64E scans, one core", ">= 20 Hz", "items"),
+    ("BM_LocalizationQuery/10000", "localization query (100 segments, k = 16) against 10k "
+     "segments", "<= 5 ms", "ms"),
+    ("BM_LocalizationQuery/100000", "... 100k segments", "<= 10 ms", "ms"),
+    ("BM_LocalizationQuery/1000000", "... 1M segments", "<= 30 ms", "ms"),
+]
+
+TO_MS = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+
+
+def benchmark_cell(b, unit):
+    ms = b["real_time"] * TO_MS[b["time_unit"]]
+    if unit == "Hz":
+        return f"{b['Hz']:.1f} Hz ({ms:.1f} ms)" if "Hz" in b else f"{1000 / ms:.1f} Hz"
+    if unit == "items":
+        return f"{b['items_per_second']:.0f} /s"
+    if "search_ms" in b:
+        return f"{ms:.1f} ms (search {b['search_ms']:.1f} ms)"
+    return f"{ms:.1f} ms"
+
+
+def benchmarks_by_name(inputs):
+    """The benchmarks of Google Benchmark JSON files by name, without its /real_time suffixes."""
+    found = {}
+    for path in inputs:
+        data = load_json(path, "benchmarks", "a Google Benchmark JSON (--benchmark_out)")
+        for b in data["benchmarks"]:
+            # The mean of repetitions when there are any, else the one run.
+            name = b.get("run_name", b["name"])
+            if b.get("aggregate_name", "mean") == "mean":
+                found[re.sub(r"/(real_time|min_time:[0-9.]+|iterations:[0-9]+)", "", name)] = b
+    return found
+
+
+def benchmarks_table(inputs):
+    found = benchmarks_by_name(inputs)
+    rows = [[what, f"`{name}`", target, benchmark_cell(found[name], unit)]
+            for name, what, target, unit in BENCHMARKS if name in found]
+    if not rows:
+        fail(f"{', '.join(inputs)}: none of the benchmarks the table shows")
+    return table([("what", 0), ("benchmark", 0), ("target", 0), ("measured", 0)], rows)
+
+
+def memory_table(inputs):
+    """The resident set while localizing, at each kilometre, and its growth after the first."""
+    rows, width = [], 0
+    for label, path in labelled(inputs):
+        try:
+            with open(path, encoding="utf-8") as f:
+                samples = [(float(r["distance_m"]) / 1000, float(r["rss_mb"]))
+                           for r in csv.DictReader(f) if r["phase"] == "localize"]
+        except (OSError, KeyError, ValueError) as e:
+            fail(f"{path}: not an rss.csv of semsegmap_memory_run: {e}")
+        if not samples or samples[-1][0] < 1:
+            fail(f"{path}: localized less than 1 km, too short to measure growth")
+        # The first sample at or after each whole kilometre, as the run prints it.
+        at_km = [next(mb for km, mb in samples if km >= k) for k in range(int(samples[-1][0]) + 1)]
+        largest = max(mb for km, mb in samples if km >= 1)
+        rows.append((label, at_km, samples[-1], 100 * (largest - at_km[1]) / at_km[1]))
+        width = max(width, len(at_km))
+    header = ([("run", 0)] + [(f"{k} km", 1) for k in range(width)] +
+              [("at the end", 1), ("growth after 1 km", 1)])
+    return table(header, [[label, *[f"{mb:.0f}" for mb in at_km], *[""] * (width - len(at_km)),
+                           f"{last[1]:.0f} ({last[0]:.1f} km)", f"{growth:+.1f} %"]
+                          for label, at_km, last, growth in rows])
+
+
+def slam_table(inputs):
+    header = [("run", 0), ("frames", 1), ("loop closures", 1), ("ATE odometry", 1),
+              ("ATE loop-closed", 1), ("aligned: odometry", 1), ("aligned: loop-closed", 1)]
+    rows = []
+    for label, path in labelled(inputs):
+        s = load_json(path, "loop_closures", "a summary.json of semsegmap slam")
+        rmse = lambda key: "-" if s.get(key) is None else f"{s[key]['rmse_m']:.2f} m"  # noqa
+        rows.append([label, s["frames"], s["loop_closures"], rmse("ate_odometry"),
+                     rmse("ate_slam"), rmse("ate_odometry_aligned"), rmse("ate_slam_aligned")])
+    return table(header, rows)
+
+
+def segments_table(inputs):
+    header = [("config", 0), ("segments", 1), ("mean points", 1), ("mean purity", 1)]
+    rows = []
+    for label, path in labelled(inputs):
+        try:
+            with open(path, encoding="utf-8") as f:
+                segments = [(int(r["points"]), r["gt_purity"]) for r in csv.DictReader(f)]
+        except (OSError, KeyError, ValueError) as e:
+            fail(f"{path}: not a segments.csv of semsegmap segment: {e}")
+        if not segments or any(purity == "" for _, purity in segments):
+            fail(f"{path}: no segments with ground-truth purity (a run on the simulator has it)")
+        n = len(segments)
+        rows.append([label, n, f"{sum(p for p, _ in segments) / n:.0f}",
+                     f"{sum(float(q) for _, q in segments) / n:.3f}"])
+    return table(header, rows)
+
+
+def odometry_table(inputs):
+    header = [("input", 0), ("frames", 1), ("KITTI translation", 1), ("KITTI rotation", 1),
+              ("ATE (first pose anchored / aligned)", 0), ("frames on the prediction alone", 1)]
+    rows = []
+    for label, path in labelled(inputs):
+        s = load_json(path, "kitti_relative_error", "a summary.json of semsegmap odometry")
+        kitti, ate, aligned = s["kitti_relative_error"], s.get("ate"), s.get("ate_aligned")
+        if kitti is None or kitti.get("translation_percent") is None or not ate or not aligned:
+            fail(f"{path}: the run has no ground truth, or is too short for the KITTI error")
+        used = sum(s["diagnostics"]["prediction_used"].values())
+        rows.append([label, s["frames"], f"{kitti['translation_percent']:.2f} %",
+                     f"{kitti['rotation_deg_per_100m']:.3f} deg/100 m",
+                     f"{ate['rmse_m']:.2f} m / {aligned['rmse_m']:.2f} m",
+                     used])
+    return table(header, rows)
+
+
+def load_revisits(path):
+    return load_json(path, "results", "a revisits.json of semsegmap eval revisits")
+
+
+def revisits_table(inputs):
+    header = [("config", 0), ("localizations", 1), ("< 0.5 m", 1), ("< 1 m", 1), ("< 5 m", 1),
+              ("wrong (> 5 m)", 1), ("mean error", 0), ("revisits localized (< 1 m)", 1),
+              ("registered truth < 0.3 m", 1)]
+    rows = []
+    for path in inputs:
+        e = load_revisits(path)
+        for r in e["results"]:
+            compared = r.get("n_registered_compared") or 0
+            rows.append([r["config"], r["n_localizations"], r["n_error_below_0_5m"],
+                         r["n_error_below_1m"], r["n_error_below_5m"], r["n_wrong"],
+                         mean_error(r), f"{r['n_revisits_localized']} of {e['n_revisits']}",
+                         f"{r['n_registered_below_0_3m']} of {compared}" if compared else "-"])
+    return table(header, rows)
+
+
+WAKE_UP_BY = (1, 2, 3, 5, 10)
+
+
+def wake_ups_table(inputs):
+    header = ([("config", 0), ("wake-ups at a revisit", 1)] +
+              [(f"by frame {k}", 1) for k in WAKE_UP_BY] + [("first localization wrong", 1)])
+    rows = []
+    for path in inputs:
+        for r in load_revisits(path)["results"]:
+            at_revisit = [w for w in r["wake_ups"] if w["revisit"]]
+            if not r["wake_ups"]:
+                fail(f"{path}: no wake-ups (run eval revisits with --wake-up N[/EVERY])")
+            by = [sum(1 for w in at_revisit if w["localized_at_frame"] is not None
+                      and w["localized_at_frame"] <= k) for k in WAKE_UP_BY]
+            wrong = sum(1 for w in r["wake_ups"] if w["wrong_first"])
+            rows.append([r["config"], len(at_revisit), *by, wrong])
+    return table(header, rows)
+
+
+# The registrations the odometry was chosen among (bench/bench_odometry.cpp), in table order.
+REGISTRATIONS = [("BM_OdometryOurs", "ours: scan to voxel map, point-to-plane, Geman-McClure"),
+                 ("BM_OdometryPclNdt", "PCL NDT (1 m cells)"),
+                 ("BM_OdometryOpen3dIcpPointToPlane", "Open3D ICP point-to-plane (normals r = 1 m)"),
+                 ("BM_OdometryPclGicp", "PCL GICP"),
+                 ("BM_OdometryOpen3dGicp", "Open3D GICP"),
+                 ("BM_OdometryPclIcpPointToPlane", "PCL ICP point-to-plane (normals r = 1 m)")]
+
+
+def registration_table(inputs):
+    found = benchmarks_by_name(inputs)
+    rows = []
+    for name, what in REGISTRATIONS:
+        b = found.get(name)
+        if b is None:
+            continue
+        rate = b["items_per_second"]
+        verdict = "yes" if rate >= 20 else f"no: {20 / rate:.1f} times too slow"
+        rows.append([what, f"{rate:.1f}", f"{b['t_err_m']:.3f} m, {b['r_err_deg']:.3f} deg",
+                     verdict])
+    if not rows:
+        fail(f"{', '.join(inputs)}: no odometry benchmarks (BM_Odometry*)")
+    return table([("registration", 0), ("scans / s (one core)", 1),
+                  ("frame-to-frame error", 0), ("meets 20 Hz?", 0)], rows)
+
+
+TABLES = {"rigs": rigs_table, "runs": runs_table, "table-i": table_i, "configs": configs_table,
+          "label-noise": label_noise_table, "segmentation": segmentation_table,
+          "descriptors": descriptors_table, "benchmarks": benchmarks_table,
+          "memory": memory_table, "slam": slam_table,
+          "segments": segments_table, "odometry": odometry_table,
+          "revisits": revisits_table, "wake-ups": wake_ups_table,
+          "registration": registration_table}
+
+
+def replace_section(text, section, new_table, doc):
     begin, end = f"<!-- results:{section} -->\n", f"<!-- /results:{section} -->"
     start = text.find(begin)
     stop = text.find(end, start + 1) if start >= 0 else -1
     if start < 0 or stop < 0:
-        sys.exit(f"{doc}: no section '{section}' (lines {begin.strip()} and {end})")
-    return text[:start + len(begin)] + table + text[stop:]
+        fail(f"{doc}: no section '{section}' (lines {begin.strip()} and {end})")
+    return text[:start + len(begin)] + new_table + text[stop:]
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("section")
-    parser.add_argument("runs", nargs="+", metavar="LABEL=FILE")
+    parser.add_argument("inputs", nargs="+", metavar="INPUT")
+    parser.add_argument("--table", choices=sorted(TABLES), default="rigs")
     parser.add_argument("--doc", default=os.path.join(os.path.dirname(__file__), "..", "docs",
                                                       "results.md"))
     args = parser.parse_args()
-    table = HEADER
-    for run in args.runs:
-        label, sep, path = run.partition("=")
-        if not sep or not label or not path:
-            sys.exit(f"expected LABEL=FILE, got '{run}'")
-        table += "".join(rows(label, path))
+    new_table = TABLES[args.table](args.inputs)
     try:
         with open(args.doc, encoding="utf-8") as f:
             text = f.read()
     except OSError as e:
-        sys.exit(f"{args.doc}: {e.strerror}")
-    text = replace_section(text, args.section, table, args.doc)
+        fail(f"{args.doc}: {e.strerror}")
+    text = replace_section(text, args.section, new_table, args.doc)
     tmp = args.doc + ".tmp"
     with open(tmp, "w", encoding="utf-8") as f:
         f.write(text)

@@ -2,8 +2,13 @@
 the run did not know): such a cell is "-", never a made-up 0."""
 
 import json
+import os
+import re
+import shlex
 import subprocess
 import sys
+
+import pytest
 
 from conftest import source_file
 
@@ -20,3 +25,187 @@ def test_write_results_shows_unknown_values_as_a_dash(tmp_path):
                     f"front camera={results}", "--doc", str(doc)], check=True)
     row = [line for line in doc.read_text().splitlines() if line.startswith("| front camera |")]
     assert row == ["| front camera | S2 | semsegmap | 3 | - | 0 | - | 0.50 |"], doc.read_text()
+
+
+# Every kind of table from the JSON (or CSV) its command writes: a fixture of the fields the
+# writer reads, and the row it must give.
+def write_table(tmp_path, kind, inputs):
+    doc = tmp_path / "doc.md"
+    doc.write_text("<!-- results:s -->\n<!-- /results:s -->\n")
+    subprocess.run([sys.executable, source_file("scripts/write_results.py"), "s", *inputs,
+                    "--table", kind, "--doc", str(doc)], check=True, capture_output=True)
+    return [line for line in doc.read_text().splitlines() if line.startswith("|")]
+
+
+def localization_result(run, config, below_1m, odometry="simulated"):
+    return {"run": run, "config": config, "frames": 10, "n_localizations": below_1m + 1,
+            "n_error_below_1m": below_1m, "n_error_below_5m": below_1m + 1, "n_wrong": 0,
+            "mean_translation_error_m": 0.25, "mean_rotation_error_deg": 1.0,
+            "recall_along_trajectory": 0.9, "fps": 12.0, "map_segments": 40,
+            "map_bytes": 2048}
+
+
+def localization_json(tmp_path, name, results, odometry="simulated"):
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps({"query_odometry": odometry, "results": results}))
+    return str(path)
+
+
+def test_table_i_shows_the_papers_counts_beside_ours(tmp_path):
+    loc = localization_json(tmp_path, "loc", [localization_result("S3", "segmap", 7)])
+    rows = write_table(tmp_path, "table-i", [loc])
+    assert rows[2] == ("| S3 (10 frames) | segmap | 8 | 7 | 8 | 0 | 0.25 m, 1.00 deg | 0.90 "
+                       "| 40 segments, 2.0 KiB | 10 |")
+
+
+def test_configs_table_names_the_odometry_when_the_runs_differ_in_it(tmp_path):
+    drifting = localization_json(tmp_path, "a", [localization_result("S2", "semsegmap", 5),
+                                                 localization_result("S3", "semsegmap", 4)])
+    lidar = localization_json(tmp_path, "b", [localization_result("S2", "semsegmap", 9)],
+                              odometry="lidar")
+    rows = write_table(tmp_path, "configs", [drifting, lidar])
+    assert rows[0].startswith("| configuration | S2 < 1 m | S2 mean error | S3 < 1 m |")
+    assert rows[2] == ("| semsegmap, simulated odometry | 5 | 0.25 m / 1.00 deg | 4 "
+                       "| 0.25 m / 1.00 deg | 0 | 0.90 / 0.90 |")
+    assert rows[3] == "| semsegmap, lidar odometry | 9 | 0.25 m / 1.00 deg | - | - | 0 | 0.90 |"
+
+
+def test_label_noise_table_has_a_row_per_level(tmp_path):
+    levels = [f"{level}=" + localization_json(
+        tmp_path, f"l{level}", [localization_result("S2", "semsegmap", 10 - level)])
+        for level in (0, 3)]
+    rows = write_table(tmp_path, "label-noise", levels)
+    assert rows[0] == "| label noise | S2 semsegmap | wrong |"
+    assert rows[2:] == ["| 0 | 10 | 0 |", "| 3 | 7 | 0 |"]
+
+
+def test_segmentation_table_has_the_change_against_the_paper(tmp_path):
+    seg = tmp_path / "segmentation.json"
+    seg.write_text(json.dumps({
+        "results": [{"config": "semsegmap", "segments": 50, "revisit_segments": 20,
+                     "consistent": 12, "inconsistent": 8},
+                    {"config": "segmap", "segments": 60, "revisit_segments": 20,
+                     "consistent": 10, "inconsistent": 10}],
+        "consistent_change_pct": 20.0, "inconsistent_change_pct": -20.0,
+        "paper": {"consistent_change_pct": 30.97, "inconsistent_change_pct": -24.24}}))
+    rows = write_table(tmp_path, "segmentation", [str(seg)])
+    assert rows[2] == "| semsegmap | 50 | 20 | 12 (60 %) | 8 |"
+    assert rows[4] == ("| change (semsegmap vs segmap) |  |  | +20.0 % (paper +30.97 %) "
+                       "| -20.0 % (paper -24.24 %) |")
+
+
+def test_descriptor_table_takes_top_16_of_each_band(tmp_path):
+    desc = tmp_path / "descriptors.json"
+    desc.write_text(json.dumps({"bands": ["< 30 %"], "descriptors": [
+        {"name": "eigen", "top1": 0.1, "top16": 0.5, "segments_per_second": 999.6,
+         "band_curves": [[0.01 * k for k in range(1, 33)]]}]}))
+    rows = write_table(tmp_path, "descriptors", [str(desc)])
+    assert rows[0] == "| descriptor | top-1 | top-16 | top-16 < 30 % | segments/s |"
+    assert rows[2] == "| `eigen` | 0.100 | 0.500 | 0.160 | 1000 |"
+
+
+def test_benchmark_table_reads_google_benchmarks_json(tmp_path):
+    bench = tmp_path / "bench.json"
+    bench.write_text(json.dumps({"benchmarks": [
+        {"name": "BM_LocalizationQuery/10000/real_time", "run_name": "BM_LocalizationQuery/10000/real_time",
+         "real_time": 3500.0, "time_unit": "us", "search_ms": 2.4},
+        {"name": "BM_WholePipeline/0/-1/iterations:100/real_time", "real_time": 41.5,
+         "time_unit": "ms", "Hz": 24.1},
+        {"name": "BM_NotInTheTable", "real_time": 1.0, "time_unit": "ms"}]}))
+    rows = write_table(tmp_path, "benchmarks", [str(bench)])
+    assert len(rows) == 4, rows
+    assert rows[2].endswith("| `BM_WholePipeline/0/-1` | >= 20 Hz | 24.1 Hz (41.5 ms) |")
+    assert rows[3].endswith("| <= 5 ms | 3.5 ms (search 2.4 ms) |")
+
+
+def test_memory_table_gives_the_growth_after_the_first_kilometre(tmp_path):
+    rss = tmp_path / "rss.csv"
+    rss.write_text("phase,frame,distance_m,rss_mb\nmap,0,0,100\nlocalize,0,0,300\n"
+                   "localize,50,1000,400\nlocalize,100,1500,420\nlocalize,150,2100,410\n")
+    rows = write_table(tmp_path, "memory", [f"long={rss}"])
+    assert rows[0] == "| run | 0 km | 1 km | 2 km | at the end | growth after 1 km |"
+    assert rows[2] == "| long | 300 | 400 | 410 | 410 (2.1 km) | +5.0 % |"
+
+
+def test_slam_table_shows_an_unknown_error_as_a_dash(tmp_path):
+    summary = tmp_path / "summary.json"
+    summary.write_text(json.dumps({"frames": 9, "loop_closures": 3, "ate_odometry": None,
+                                   "ate_slam": {"rmse_m": 1.234}, "ate_odometry_aligned": None,
+                                   "ate_slam_aligned": None}))
+    rows = write_table(tmp_path, "slam", [f"S1={summary}"])
+    assert rows[2] == "| S1 | 9 | 3 | - | 1.23 m | - | - |"
+
+
+def test_segments_table_refuses_segments_without_ground_truth(tmp_path):
+    csv_file = tmp_path / "segments.csv"
+    csv_file.write_text("id,points,gt_purity\n1,100,0.9\n2,300,0.8\n")
+    assert write_table(tmp_path, "segments", [f"a={csv_file}"])[2] == "| a | 2 | 200 | 0.850 |"
+    csv_file.write_text("id,points,gt_purity\n1,100,\n")
+    with pytest.raises(subprocess.CalledProcessError) as e:
+        write_table(tmp_path, "segments", [f"a={csv_file}"])
+    assert b"ground-truth purity" in e.value.stderr
+
+
+def documented_writes():
+    """Every scripts/write_results.py call of docs/*.md, as its arguments."""
+    calls = []
+    for doc in sorted(os.listdir(source_file("docs"))):
+        if doc.endswith(".md"):
+            text = open(source_file(f"docs/{doc}"), encoding="utf-8").read()
+            calls += [shlex.split(line)[1:] for line in text.replace("\\\n", " ").splitlines()
+                      if line.startswith("scripts/write_results.py ")]
+    return calls
+
+
+def test_every_results_section_is_written_by_a_documented_command():
+    """docs/*.md and the README: each section is written by a write_results.py call of docs/
+    with a table kind the script has, and each call names a section of its document, so that
+    scripts/regenerate_results.py regenerates every table and only those."""
+    listed = subprocess.run([sys.executable, source_file("scripts/regenerate_results.py"),
+                             "--list"], check=True, capture_output=True, text=True).stdout
+    written = {}
+    for args in documented_writes():
+        doc = args[args.index("--doc") + 1] if "--doc" in args else "docs/results.md"
+        kind = args[args.index("--table") + 1] if "--table" in args else "rigs"
+        assert kind in write_results_kinds(), args
+        written.setdefault(doc, set()).add(args[0])
+    for doc, sections in written.items():
+        text = open(source_file(doc), encoding="utf-8").read()
+        in_doc = set(re.findall(r"^<!-- results:([\w-]+) -->$", text, re.M))
+        assert sections == in_doc, doc
+    assert set(listed.split()) == set().union(
+        *(sections for doc, sections in written.items() if doc.startswith("docs/")))
+    assert "README.md" in written, "the README's demo table is written by a documented command"
+    for doc in ["README.md"] + [f"docs/{d}" for d in os.listdir(source_file("docs"))]:
+        if doc.endswith(".md") and doc not in written:
+            text = open(source_file(doc), encoding="utf-8").read()
+            assert "<!-- results:" not in text, f"{doc} has a results section nothing writes"
+
+
+def write_results_kinds():
+    help_text = subprocess.run([sys.executable, source_file("scripts/write_results.py"), "-h"],
+                               check=True, capture_output=True, text=True).stdout
+    return set(re.search(r"--table \{([^}]*)\}", help_text).group(1).split(","))
+
+
+def test_regenerate_runs_the_block_before_a_section_once_and_refuses_an_unknown_one(tmp_path):
+    """The runner on a copy of the repository's layout: a block that writes two sections runs
+    once, --tables-only keeps only the write and copy lines, an unknown section is refused."""
+    root = tmp_path / "repo"
+    (root / "scripts").mkdir(parents=True)
+    (root / "docs").mkdir()
+    for script in ("regenerate_results.py", "write_results.py"):
+        (root / "scripts" / script).write_text(open(source_file(f"scripts/{script}")).read())
+    (root / "docs" / "a.md").write_text(
+        "```sh\necho measured >> data.log\ncp data.log copy.log\n```\n"
+        "<!-- results:one -->\n<!-- /results:one -->\n<!-- results:two -->\n"
+        "<!-- /results:two -->\n")
+    runner = [sys.executable, str(root / "scripts" / "regenerate_results.py")]
+    subprocess.run(runner + ["one", "two"], check=True, cwd=tmp_path, capture_output=True)
+    assert (root / "data.log").read_text() == "measured\n"
+    subprocess.run(runner + ["--tables-only"], check=True, cwd=tmp_path, capture_output=True)
+    assert (root / "data.log").read_text() == "measured\n", "--tables-only measured again"
+    listed = subprocess.run(runner + ["--list"], check=True, capture_output=True, text=True)
+    assert listed.stdout.split() == ["one", "two"]
+    refused = subprocess.run(runner + ["three"], capture_output=True, text=True)
+    assert refused.returncode != 0 and "no section three" in refused.stderr
