@@ -248,6 +248,13 @@ def benchmark_cell(b, unit):
     return f"{ms:.1f} ms"
 
 
+def machine_line(inputs):
+    """Where and when the benchmarks ran, from Google Benchmark's own context."""
+    c = load_json(inputs[0], "context", "a Google Benchmark JSON (--benchmark_out)")["context"]
+    return (f"\nMeasured on {c.get('num_cpus', '?')} CPUs at {c.get('mhz_per_cpu', '?')} MHz, "
+            f"{c.get('date', '?')[:10]}.\n")
+
+
 def benchmarks_by_name(inputs):
     """The benchmarks of Google Benchmark JSON files by name, without its /real_time suffixes."""
     found = {}
@@ -267,7 +274,8 @@ def benchmarks_table(inputs):
             for name, what, target, unit in BENCHMARKS if name in found]
     if not rows:
         fail(f"{', '.join(inputs)}: none of the benchmarks the table shows")
-    return table([("what", 0), ("benchmark", 0), ("target", 0), ("measured", 0)], rows)
+    return (table([("what", 0), ("benchmark", 0), ("target", 0), ("measured", 0)], rows) +
+            machine_line(inputs))
 
 
 def memory_table(inputs):
@@ -401,8 +409,8 @@ def registration_table(inputs):
                      verdict])
     if not rows:
         fail(f"{', '.join(inputs)}: no odometry benchmarks (BM_Odometry*)")
-    return table([("registration", 0), ("scans / s (one core)", 1),
-                  ("frame-to-frame error", 0), ("meets 20 Hz?", 0)], rows)
+    return (table([("registration", 0), ("scans / s (one core)", 1),
+                   ("frame-to-frame error", 0), ("meets 20 Hz?", 0)], rows) + machine_line(inputs))
 
 
 TABLES = {"rigs": rigs_table, "runs": runs_table, "table-i": table_i, "configs": configs_table,

@@ -106,7 +106,8 @@ def test_descriptor_table_takes_top_16_of_each_band(tmp_path):
 
 def test_benchmark_table_reads_google_benchmarks_json(tmp_path):
     bench = tmp_path / "bench.json"
-    bench.write_text(json.dumps({"benchmarks": [
+    bench.write_text(json.dumps({"context": {"num_cpus": 2, "mhz_per_cpu": 2445,
+                                             "date": "2026-12-05T11:10:00+00:00"}, "benchmarks": [
         {"name": "BM_LocalizationQuery/10000/real_time", "run_name": "BM_LocalizationQuery/10000/real_time",
          "real_time": 3500.0, "time_unit": "us", "search_ms": 2.4},
         {"name": "BM_WholePipeline/0/-1/iterations:100/real_time", "real_time": 41.5,
@@ -116,6 +117,7 @@ def test_benchmark_table_reads_google_benchmarks_json(tmp_path):
     assert len(rows) == 4, rows
     assert rows[2].endswith("| `BM_WholePipeline/0/-1` | >= 20 Hz | 24.1 Hz (41.5 ms) |")
     assert rows[3].endswith("| <= 5 ms | 3.5 ms (search 2.4 ms) |")
+    assert "Measured on 2 CPUs at 2445 MHz, 2026-12-05." in (tmp_path / "doc.md").read_text()
 
 
 def test_memory_table_gives_the_growth_after_the_first_kilometre(tmp_path):
