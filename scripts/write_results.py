@@ -89,25 +89,25 @@ def table(header, rows):
     return out + "".join("| " + " | ".join(str(c) for c in row) + " |\n" for row in rows)
 
 
-def rigs_table(inputs):
-    header = [("rig", 0), ("run", 0), ("config", 0), ("localizations", 1), ("< 1 m", 1),
+RUN_HEADER = [("run", 0), ("config", 0), ("localizations", 1), ("< 1 m", 1),
               ("wrong (> 5 m)", 1), ("mean error", 0), ("recall (20 m)", 1)]
-    rows = []
-    for label, path in labelled(inputs):
-        for r in load_localization(path)["results"]:
-            rows.append([label, r["run"], r["config"], r["n_localizations"],
-                         shown(r.get("n_error_below_1m")), r["n_wrong"], mean_error(r),
-                         f"{r['recall_along_trajectory']:.2f}"])
-    return table(header, rows)
+
+
+def run_row(r):
+    """A localization result's cells as the rigs and demo tables show them."""
+    return [r["run"], r["config"], r["n_localizations"], shown(r.get("n_error_below_1m")),
+            r["n_wrong"], mean_error(r), f"{r['recall_along_trajectory']:.2f}"]
+
+
+def rigs_table(inputs):
+    return table([("rig", 0)] + RUN_HEADER,
+                 [[label, *run_row(r)] for label, path in labelled(inputs)
+                  for r in load_localization(path)["results"]])
 
 
 def runs_table(inputs):
-    header = [("run", 0), ("config", 0), ("localizations", 1), ("< 1 m", 1),
-              ("wrong (> 5 m)", 1), ("mean error", 0), ("recall (20 m)", 1)]
-    rows = [[r["run"], r["config"], r["n_localizations"], shown(r.get("n_error_below_1m")),
-             r["n_wrong"], mean_error(r), f"{r['recall_along_trajectory']:.2f}"]
-            for path in inputs for r in load_localization(path)["results"]]
-    return table(header, rows)
+    return table(RUN_HEADER, [run_row(r) for path in inputs
+                              for r in load_localization(path)["results"]])
 
 
 def table_i(inputs):

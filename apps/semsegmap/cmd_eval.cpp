@@ -163,14 +163,13 @@ int runEvalPaper(const CliArgs& a) {
   LocalizationExperimentConfig lc = localizationConfig(a);
   sc.stop = dc.stop = lc.stop = stopToken();
   StageProgress progress;
-  std::optional<SegmentationExperiment> s;
+  const SegmentationExperiment s = evaluateSegmentation(sc, std::ref(progress));
+  if (s.interrupted && !progress.started()) return experimentEnd(a, true, progress);
+  writeSegmentationFiles(s, out);
+  std::cout << segmentationTable(s) << "\n";
   std::optional<DescriptorExperiment> d;
   std::optional<LocalizationExperiment> l;
-  s = evaluateSegmentation(sc, std::ref(progress));
-  if (s->interrupted && !progress.started()) return experimentEnd(a, true, progress);
-  writeSegmentationFiles(*s, out);
-  std::cout << segmentationTable(*s) << "\n";
-  if (!s->interrupted) {
+  if (!s.interrupted) {
     d = runDescriptorExperiment(dc, out, std::ref(progress));
     std::cout << descriptorTable(*d) << "\n";
   }
@@ -184,9 +183,9 @@ int runEvalPaper(const CliArgs& a) {
   context.command = "semsegmap eval paper";
   for (const std::string& arg : a.args()) context.command += " " + arg;
   context.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  context.interrupted = s->interrupted || (d && d->interrupted) || (l && l->interrupted);
+  context.interrupted = s.interrupted || (d && d->interrupted) || (l && l->interrupted);
   writeBytesAtomically(out / "report.md",
-                       paperReport(context, &*s, d ? &*d : nullptr, l ? &*l : nullptr));
+                       paperReport(context, &s, d ? &*d : nullptr, l ? &*l : nullptr));
   std::cout << "wrote " << (out / "report.md").string() << "\n";
   return experimentEnd(a, context.interrupted, progress);
 }
