@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -78,6 +79,36 @@ TEST(GroundTruthCheck, RegistersTheQueryToTheMappedScansNearestIt) {
   const auto there = check.registered(scanAt(world, near_one), near_one);
   ASSERT_TRUE(there.has_value());
   EXPECT_GT(yawErrorDeg(*there, near_one), 1.5);
+}
+
+// A pose metres off is beyond the coarse registration, whose voxel map looks for a point's
+// correspondence one voxel around it; a first pass on voxels of initial_distance_m reaches it
+// (Scan Context's matches start there). Points that are not finite are left out.
+TEST(GroundTruthCheck, AFirstPassOnLargerVoxelsReachesAPoseMetresOff) {
+  const std::vector<Eigen::Vector3d> world = street(3);
+  GroundTruthCheckConfig coarse_only;
+  coarse_only.max_correction_m = 5.0;
+  GroundTruthCheckConfig reaching = coarse_only;
+  reaching.initial_distance_m = 4.0;
+  GroundTruthCheck without(coarse_only), with(reaching);
+  for (const double x : {0.0, 10.0, 20.0}) {
+    without.addMapped(scanAt(world, lidarAt(x, 0)), lidarAt(x, 0));
+    with.addMapped(scanAt(world, lidarAt(x, 0)), lidarAt(x, 0));
+  }
+  const Pose truth = lidarAt(12, 4);
+  const Pose given = Eigen::Translation3d(2.5, -1.5, 0.0) * lidarAt(12, 6);
+  std::vector<LidarPoint> scan = scanAt(world, truth);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  scan.push_back({nan, nan, nan, 0.f});
+  scan.push_back({1.f, std::numeric_limits<float>::infinity(), 0.f, 0.f});
+  const auto reached = with.registered(scan, given);
+  ASSERT_TRUE(reached.has_value());
+  EXPECT_LT((reached->translation() - truth.translation()).norm(), 0.05);
+  EXPECT_LT(yawErrorDeg(*reached, truth), 0.2);
+  const auto stuck = without.registered(scan, given);
+  if (stuck) {
+    EXPECT_GT((stuck->translation() - truth.translation()).norm(), 1.0);
+  }
 }
 
 TEST(GroundTruthCheck, NeedsAMappedScanNearAndAtLeastOneNearest) {

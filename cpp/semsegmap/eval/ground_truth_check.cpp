@@ -10,10 +10,15 @@ namespace semsegmap {
 
 namespace {
 
+// Points that are not finite (a robot's driver may mark missing returns so) are left out: their
+// voxel keys would be undefined.
 std::vector<Eigen::Vector3d> toVectors(const std::vector<LidarPoint>& points, const Pose& T) {
   std::vector<Eigen::Vector3d> out;
   out.reserve(points.size());
-  for (const LidarPoint& p : points) out.push_back(T * Eigen::Vector3d(p.x, p.y, p.z));
+  for (const LidarPoint& p : points) {
+    const Eigen::Vector3d v(p.x, p.y, p.z);
+    if (v.allFinite()) out.push_back(T * v);
+  }
   return out;
 }
 
@@ -34,39 +39,57 @@ void GroundTruthCheck::addMapped(const std::vector<LidarPoint>& points, const Po
   scans_.push_back(std::move(scan));
 }
 
-VoxelMap GroundTruthCheck::referenceNear(const Eigen::Vector3d& position) const {
+uint64_t GroundTruthCheck::bytes() const {
+  uint64_t bytes = 0;
+  for (const MappedScan& scan : scans_) bytes += scan.points.size() * sizeof(Eigen::Vector3f);
+  return bytes;
+}
+
+std::vector<size_t> GroundTruthCheck::scansNear(const Eigen::Vector3d& position) const {
   std::vector<std::pair<double, size_t>> by_distance;
   for (size_t i = 0; i < scans_.size(); ++i) {
     const double d = (scans_[i].position - position).norm();
     if (d <= config_.near_m) by_distance.emplace_back(d, i);
   }
   std::sort(by_distance.begin(), by_distance.end());
-  size_t n = 0;
-  while (n < by_distance.size() && n < config_.max_scans &&
-         (n < config_.nearest_scans || by_distance[n].first <= config_.place_m))
-    ++n;
+  std::vector<size_t> near;
+  while (near.size() < by_distance.size() && near.size() < config_.max_scans &&
+         (near.size() < config_.nearest_scans || by_distance[near.size()].first <= config_.place_m))
+    near.push_back(by_distance[near.size()].second);
+  return near;
+}
+
+VoxelMap GroundTruthCheck::reference(const std::vector<size_t>& scans, double voxel_size_m) const {
   // The nearest first: a voxel keeps its first points.
-  VoxelMap map(config_.voxel_size_m, 20);
-  for (size_t k = 0; k < n; ++k) {
+  VoxelMap map(voxel_size_m, 20);
+  for (const size_t i : scans) {
     std::vector<Eigen::Vector3d> world;
-    for (const Eigen::Vector3f& p : scans_[by_distance[k].second].points)
-      world.push_back(p.cast<double>());
-    map.add(voxelDownsample(world, 0.5 * config_.voxel_size_m), world);
+    for (const Eigen::Vector3f& p : scans_[i].points) world.push_back(p.cast<double>());
+    map.add(voxelDownsample(world, 0.5 * voxel_size_m), world);
   }
   return map;
 }
 
 std::optional<Pose> GroundTruthCheck::registered(const std::vector<LidarPoint>& points,
                                                  const Pose& T_world_lidar) const {
-  const VoxelMap map = referenceNear(T_world_lidar.translation());
+  const std::vector<size_t> near = scansNear(T_world_lidar.translation());
+  const VoxelMap map = reference(near, config_.voxel_size_m);
   if (map.empty()) return std::nullopt;
   const std::vector<Eigen::Vector3d> scan =
       voxelDownsample(toVectors(points, Pose::Identity()), config_.voxel_size_m);
   IcpConfig icp;
   icp.min_correspondences = config_.min_correspondences;
+  IcpResult r;
+  r.T = T_world_lidar;
+  // The scan as fine as in the later passes: downsampled to the first pass's voxels, KITTI 00's
+  // scans 1615 and 1634 kept too few correspondences (min_correspondences).
+  if (config_.initial_distance_m > 0) {
+    const double reach = config_.initial_distance_m;
+    r = alignToMap(scan, reference(near, reach), r.T, reach, reach / 3, icp);
+    if (!r.enough_correspondences) return std::nullopt;
+  }
   // Coarse then fine, as the pose refinement does: the kernel a third of the reach.
-  IcpResult r = alignToMap(scan, map, T_world_lidar, config_.coarse_distance_m,
-                           config_.coarse_distance_m / 3, icp);
+  r = alignToMap(scan, map, r.T, config_.coarse_distance_m, config_.coarse_distance_m / 3, icp);
   if (!r.enough_correspondences) return std::nullopt;
   r = alignToMap(scan, map, r.T, config_.fine_distance_m, config_.fine_distance_m / 3, icp);
   if (!r.enough_correspondences) return std::nullopt;

@@ -10,6 +10,7 @@
 // 24 mapped scans added in recording order it lands where scan 95 puts it).
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -23,9 +24,15 @@ namespace semsegmap {
 
 struct GroundTruthCheckConfig {
   double voxel_size_m = 0.5;       // of the reference map and the downsampled query scan
-  double coarse_distance_m = 1.5;  // first registration: correspondences this far
+  double coarse_distance_m = 1.5;  // coarse registration: correspondences this far
   double fine_distance_m = 0.3;    // then this far
   double max_correction_m = 3.0;   // a registration moving the pose farther has failed
+  // For a pose off by more than the coarse registration reaches: a voxel map finds a point's
+  // correspondence among the voxels around it alone, about one voxel away, so the coarse pass
+  // covers about voxel_size_m whatever coarse_distance_m says. Above 0, a first registration to
+  // a reference of voxels this large, with correspondences this far, comes before it (Scan
+  // Context's matches start metres from the query: eval/scan_context_localizer.h).
+  double initial_distance_m = 0.0;
   size_t min_correspondences = 500;
   // The reference of a query: every mapped scan within place_m of it, but at least the
   // nearest_scans nearest and at most max_scans, all within near_m (with none that near, the
@@ -47,6 +54,7 @@ class GroundTruthCheck {
   // it, or nothing when too little of it overlaps them or the registration fails.
   std::optional<Pose> registered(const std::vector<LidarPoint>& points,
                                  const Pose& T_world_lidar) const;
+  uint64_t bytes() const;  // of the mapped scans' points it keeps
 
  private:
   // A mapped scan in the world frame, downsampled to a quarter of the reference map's voxels
@@ -55,7 +63,9 @@ class GroundTruthCheck {
     Eigen::Vector3d position;
     std::vector<Eigen::Vector3f> points;
   };
-  VoxelMap referenceNear(const Eigen::Vector3d& position) const;
+  // The mapped scans a query at `position` registers to, the nearest first.
+  std::vector<size_t> scansNear(const Eigen::Vector3d& position) const;
+  VoxelMap reference(const std::vector<size_t>& scans, double voxel_size_m) const;
 
   GroundTruthCheckConfig config_;
   std::vector<MappedScan> scans_;
