@@ -143,7 +143,8 @@ const std::vector<CommandOptions> kAllCommands = {
      {"descriptors", "segmentation-run"}},
     {"eval revisits",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "map-frames",
-      "query-frames", "configs", "place-radius", "check-ground-truth", "wake-up", "out"},
+      "query-frames", "configs", "place-radius", "check-ground-truth", "wake-up", "scan-context",
+      "out"},
      {"world-seed", "preset", "map-run"}},
     {"eval semantics",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
@@ -1707,8 +1708,12 @@ TEST(CliEvalRevisits, RunsOnTheRealKittiScansInEveryBuild) {
                        " --map-frames 0:23 --query-frames 24:35 --configs " + config.string() +
                        " --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("| config | localizations | < 0.5 m | < 1 m |"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("| eigen-kitti |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| config | method | localizations | < 0.5 m | < 1 m |"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("| eigen-kitti | segments (eigen) |"), std::string::npos) << r.out;
+  // Scan Context beside it by default, with its folder.
+  EXPECT_NE(r.out.find("| scan-context | Scan Context (whole scan) |"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(out / "scan-context" / "localizations.csv"));
   const std::string json = readFile(out / "revisits.json");
   EXPECT_NE(json.find("\"n_queries\": 12"), std::string::npos) << json.substr(0, 600);
   EXPECT_NE(json.find("\"n_revisits\": 3"), std::string::npos) << json.substr(0, 600);
@@ -1720,6 +1725,17 @@ TEST(CliEvalRevisits, RunsOnTheRealKittiScansInEveryBuild) {
       readFile(out / "eigen-kitti" / "summary.json").find("\"odometry_is_ground_truth\": true"),
       std::string::npos);
   EXPECT_GT(std::filesystem::file_size(out / "revisits.png"), 1000u);
+  // --scan-context off leaves it out; it takes on or off alone.
+  const std::filesystem::path off = tmp.path() / "off";
+  const std::string few = "eval revisits --dataset semantickitti:" + kitti.string() +
+                          " --map-frames 0:1 --query-frames 24:25 --configs " + config.string();
+  const Result without = run(few + " --scan-context off --out " + off.string());
+  ASSERT_EQ(without.code, 0) << without.err;
+  EXPECT_EQ(without.out.find("scan-context"), std::string::npos) << without.out;
+  EXPECT_FALSE(std::filesystem::exists(off / "scan-context"));
+  const Result typo = run(few + " --scan-context no --out " + (tmp.path() / "typo").string());
+  EXPECT_EQ(typo.code, 2) << typo.err;
+  EXPECT_NE(typo.err.find("--scan-context"), std::string::npos) << typo.err;
 }
 
 // The README's and docs/class-maps.md's eval semantics, as typed: a label set made with a real

@@ -24,6 +24,7 @@ int runEvalRevisits(const CliArgs& a) {
     c.query_frames = parseFrameRanges(a.get("query-frames"), "option --query-frames");
     if (a.has("wake-up")) parseWakeUp(a.get("wake-up"), "option --wake-up", c);
     c.check_ground_truth = a.has("check-ground-truth");
+    if (a.get("scan-context") == "off") c.scan_context.reset();
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
@@ -41,7 +42,8 @@ int runEvalRevisits(const CliArgs& a) {
   if (e.interrupted && !progress.started()) return interruptedStages("eval revisits", progress, "");
   writeRevisitFiles(e, out);
   std::cout << revisitTable(e) << "wrote " << (out / "revisits.json").string()
-            << ", revisits.png and one folder per configuration\n";
+            << ", revisits.png and one folder per configuration"
+            << (c.scan_context ? " (and scan-context/)" : "") << "\n";
   return e.interrupted ? interruptedStages("eval revisits", progress, out.string()) : 0;
 }
 
@@ -69,6 +71,9 @@ const CommandSpec& evalRevisitsCommand() {
            {"wake-up", Value::kText, "N[/EVERY]", "",
             "the kidnapped robot: wake up at every EVERY-th query frame (default N) with an "
             "empty local map and localize from the N frames from there"},
+           {"scan-context", Value::kText, "on|off", "on",
+            "also localize each query frame on its own by Scan Context (whole-scan descriptors "
+            "of the mapped scans, ICP from the match), the row scan-context"},
            {"out", Value::kText, "DIR", "", "output folder", kRequired}}),
       "",
       runEvalRevisits,

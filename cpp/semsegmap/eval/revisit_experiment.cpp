@@ -1,6 +1,7 @@
 #include "semsegmap/eval/revisit_experiment.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -39,6 +40,11 @@ void checkRevisitInput(const FrameSource& source, const RevisitExperimentConfig&
   const std::string name = source.info().name;
   if (cfg.configs.empty())
     throw std::invalid_argument("eval revisits needs at least one configuration");
+  for (const NamedConfig& c : cfg.configs)
+    if (cfg.scan_context && c.name == kScanContextName)
+      throw std::invalid_argument("eval revisits: configuration " + c.path.string() +
+                                  " is named like Scan Context's results (" + kScanContextName +
+                                  "); rename it, or leave Scan Context out");
   if (!source.info().has_ground_truth_poses)
     throw std::invalid_argument(name +
                                 ": eval revisits needs ground-truth poses (--ground-truth FILE)");
@@ -67,13 +73,19 @@ void checkRevisitInput(const FrameSource& source, const RevisitExperimentConfig&
         "eval revisits: with wake-ups the query ranges must not overlap each other");
 }
 
-// The map frames, read once for every configuration, on ground-truth poses; their ground-truth
-// positions go to `mapped_positions`.
+// What the map frames leave besides the segment maps: their ground-truth positions, and their
+// scans for the ground-truth check and for Scan Context (each when asked for).
+struct MappedScans {
+  std::vector<Eigen::Vector3d> positions;
+  std::optional<GroundTruthCheck> check;
+  std::optional<ScanContextLocalizer> scan_context;
+};
+
+// The map frames, read once for every configuration, on ground-truth poses.
 std::vector<BuiltMap> buildMaps(FrameSource& source, RevisitExperiment& e,
                                 const std::vector<std::shared_ptr<Describer>>& describers,
-                                const std::filesystem::path& out,
-                                std::vector<Eigen::Vector3d>& mapped_positions,
-                                const ExperimentProgress& progress, GroundTruthCheck* check) {
+                                const std::filesystem::path& out, MappedScans& mapped,
+                                const ExperimentProgress& progress) {
   const RevisitExperimentConfig& cfg = e.config;
   FrameSubset frames(source, framesOf(cfg.map_frames));
   auto sessions =
@@ -83,8 +95,10 @@ std::vector<BuiltMap> buildMaps(FrameSource& source, RevisitExperiment& e,
       throw std::runtime_error(source.info().name + ": frame " +
                                std::to_string(frames.datasetFrame(frame.index)) +
                                " has no ground-truth pose");
-    mapped_positions.push_back(frame.T_world_base->translation());
-    if (check) check->addMapped(frame.points, *frame.T_world_base * source.info().rig.T_base_lidar);
+    mapped.positions.push_back(frame.T_world_base->translation());
+    const Pose T_world_lidar = *frame.T_world_base * source.info().rig.T_base_lidar;
+    if (mapped.check) mapped.check->addMapped(frame.points, T_world_lidar);
+    if (mapped.scan_context) mapped.scan_context->addMapped(frame.points, T_world_lidar);
     for (auto& s : sessions) s->process(frame);
   });
   return finishMaps(sessions, cfg.configs, out);
@@ -123,14 +137,25 @@ std::vector<WakeUp> wakeUpsOf(const RevisitExperiment& e,
   return out;
 }
 
-RevisitResult resultOf(const RevisitExperiment& e, const NamedConfig& config,
-                       const LocalizationRun& run, const BuiltMap& map) {
+// A localization against the query scan's registered ground truth (check_ground_truth).
+void compareWithRegistered(RevisitResult& r, const LocalizationRecord& l, const RevisitFrame& q) {
+  const double error =
+      (l.T_map_base.translation() - q.T_world_base_registered->translation()).norm();
+  const double angle = rotationErrorDeg(l.T_map_base, *q.T_world_base_registered);
+  r.localizations.back().registered_error_m = error;
+  r.localizations.back().registered_rotation_error_deg = angle;
+  ++r.registered_compared;
+  r.registered_below_0_3m += error < 0.3 && angle < 1.0;
+  r.mean_registered_error_m += error;
+  r.mean_registered_rotation_error_deg += angle;
+}
+
+// The counts, errors, wake-ups and time of one run's localizations, whichever method made them.
+RevisitResult resultOf(const RevisitExperiment& e, const std::string& name,
+                       const LocalizationRun& run) {
   RevisitResult r;
-  r.config = config.name;
-  r.descriptor = map.map->descriptor;
-  r.map_segments = map.map->size();
-  r.map_bytes = map.bytes;
-  r.dir = config.name;
+  r.config = name;
+  r.dir = name;
   for (const LocalizationRecord& l : run.localizations) {
     r.localizations.push_back(
         {l.frame_index, l.inliers, l.translation_error_m, l.rotation_error_deg});
@@ -142,17 +167,7 @@ RevisitResult resultOf(const RevisitExperiment& e, const NamedConfig& config,
                                 [&](const RevisitFrame& f) { return f.frame == l.frame_index; });
     r.revisits_localized +=
         q != e.queries.end() && q->revisit && l.translation_error_m < e.config.correct_m;
-    if (q != e.queries.end() && q->T_world_base_registered) {
-      const double error =
-          (l.T_map_base.translation() - q->T_world_base_registered->translation()).norm();
-      const double angle = rotationErrorDeg(l.T_map_base, *q->T_world_base_registered);
-      r.localizations.back().registered_error_m = error;
-      r.localizations.back().registered_rotation_error_deg = angle;
-      ++r.registered_compared;
-      r.registered_below_0_3m += error < 0.3 && angle < 1.0;
-      r.mean_registered_error_m += error;
-      r.mean_registered_rotation_error_deg += angle;
-    }
+    if (q != e.queries.end() && q->T_world_base_registered) compareWithRegistered(r, l, *q);
   }
   if (r.registered_compared > 0) {
     r.mean_registered_error_m /= static_cast<double>(r.registered_compared);
@@ -162,6 +177,17 @@ RevisitResult resultOf(const RevisitExperiment& e, const NamedConfig& config,
   const LocalizationSummary s = summarize(run.localizations);
   r.mean_translation_error_m = s.mean_translation_error_m;
   r.mean_rotation_error_deg = s.mean_rotation_error_deg;
+  if (run.stats.frames > 0)
+    r.ms_per_query = run.stats.total.total() / static_cast<double>(run.stats.frames);
+  return r;
+}
+
+RevisitResult segmentResultOf(const RevisitExperiment& e, const NamedConfig& config,
+                              const LocalizationRun& run, const BuiltMap& map) {
+  RevisitResult r = resultOf(e, config.name, run);
+  r.descriptor = map.map->descriptor;
+  r.map_segments = map.map->size();
+  r.map_bytes = map.bytes;
   return r;
 }
 
@@ -177,20 +203,19 @@ void writeRunFiles(const NamedConfig& config, const LocalizationRun& run, const 
 
 // Where a query frame lies against the mapped ones, noted once for every configuration.
 void noteQuery(RevisitExperiment& e, size_t dataset_frame, const Frame& frame,
-               const std::vector<Eigen::Vector3d>& mapped_positions, const Pose& T_base_lidar,
-               const GroundTruthCheck* check) {
+               const MappedScans& mapped, const Pose& T_base_lidar) {
   RevisitFrame q;
   q.frame = dataset_frame;
   q.nearest_mapped_m = std::numeric_limits<double>::infinity();
   if (frame.T_world_base)
-    for (const Eigen::Vector3d& p : mapped_positions)
+    for (const Eigen::Vector3d& p : mapped.positions)
       q.nearest_mapped_m =
           std::min(q.nearest_mapped_m, (frame.T_world_base->translation() - p).norm());
   q.revisit = q.nearest_mapped_m <= e.config.place_radius_m;
   e.revisits += q.revisit;
   // Every query frame: one farther than place_radius_m may still overlap the map.
-  if (check && frame.T_world_base) {
-    if (const auto T = check->registered(frame.points, *frame.T_world_base * T_base_lidar)) {
+  if (mapped.check && frame.T_world_base) {
+    if (const auto T = mapped.check->registered(frame.points, *frame.T_world_base * T_base_lidar)) {
       q.T_world_base_registered = *T * T_base_lidar.inverse();
       q.ground_truth_correction_m =
           (q.T_world_base_registered->translation() - frame.T_world_base->translation()).norm();
@@ -210,6 +235,57 @@ void summarizeCorrections(RevisitExperiment& e) {
   if (e.registered > 0) e.mean_correction_m /= static_cast<double>(e.registered);
 }
 
+// Scan Context's localization of one query frame, on its own, recorded into `run` as the
+// sessions record theirs (under the dataset's frame number), its time as the localization's.
+void localizeByScanContext(const ScanContextLocalizer& scan_context, const Frame& frame,
+                           size_t dataset_frame, const DatasetInfo& info, LocalizationRun& run) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::optional<ScanContextLocalization> found = scan_context.localize(frame.points);
+  run.stats.total.localize_ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ++run.stats.frames;
+  run.frames.push_back(stampOf(frame, info));
+  run.trajectory_odom.push_back(frame.T_odom_base);
+  if (frame.T_world_base) run.trajectory_gt.push_back(*frame.T_world_base);
+  if (!found) return;
+  LocalizationRecord l;
+  l.frame_index = dataset_frame;
+  l.frame_number = run.frames.back().number;
+  l.timestamp_s = run.frames.back().time_s;
+  l.T_map_base = found->T_world_lidar * info.rig.T_base_lidar.inverse();
+  l.candidates = 1;
+  if (frame.T_world_base) {
+    l.T_world_base = *frame.T_world_base;
+    l.translation_error_m = translationError(l.T_map_base, *frame.T_world_base);
+    l.rotation_error_deg = rotationErrorDeg(l.T_map_base, *frame.T_world_base);
+  }
+  run.localizations.push_back(std::move(l));
+}
+
+RevisitResult scanContextResultOf(const RevisitExperiment& e, const LocalizationRun& run,
+                                  const ScanContextLocalizer& scan_context) {
+  RevisitResult r = resultOf(e, kScanContextName, run);
+  r.method = kScanContextName;
+  r.descriptor = kScanContextName;
+  r.mapped_scans = scan_context.size();
+  r.map_bytes = scan_context.bytes();
+  return r;
+}
+
+// Its folder as a configuration's (writeLocalizationRunFiles), with a map of no segments: the
+// picture shows the drive and the localizations alone.
+void writeScanContextFiles(const LocalizationRun& run, const RevisitResult& r,
+                           const RevisitExperiment& e, const std::filesystem::path& out) {
+  auto map = std::make_shared<TargetMap>();
+  map->descriptor = r.descriptor;
+  SummaryContext context;
+  context.dataset = e.dataset;
+  context.map = "(the mapped scans' scan contexts, in memory)";
+  context.config = kScanContextName;
+  writeLocalizationRunFiles(out / r.dir, run, BuiltMap{map, r.map_bytes}, context,
+                            e.dataset + ": revisits against its own mapped scans, Scan Context");
+}
+
 void appendRun(LocalizationRun& all, LocalizationRun run) {
   for (LocalizationRecord& l : run.localizations) all.localizations.push_back(std::move(l));
   all.trajectory_gt.insert(all.trajectory_gt.end(), run.trajectory_gt.begin(),
@@ -227,12 +303,11 @@ void appendRun(LocalizationRun& all, LocalizationRun run) {
 // over them all, or with wake-ups a fresh one (an empty local map) each.
 void localizeQueries(FrameSource& source, RevisitExperiment& e,
                      const std::vector<std::shared_ptr<Describer>>& describers,
-                     const std::vector<BuiltMap>& maps,
-                     const std::vector<Eigen::Vector3d>& mapped_positions,
-                     const std::filesystem::path& out, const ExperimentProgress& progress,
-                     const GroundTruthCheck* check) {
+                     const std::vector<BuiltMap>& maps, const MappedScans& mapped,
+                     const std::filesystem::path& out, const ExperimentProgress& progress) {
   const RevisitExperimentConfig& cfg = e.config;
   std::vector<LocalizationRun> runs(cfg.configs.size());
+  LocalizationRun scan_context_run;
   for (const std::vector<FrameRange>& ranges : querySessions(cfg)) {
     if (e.interrupted) break;  // no session starts after the stop request
     FrameSubset frames(source, framesOf(ranges));
@@ -241,9 +316,12 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
       sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source.info(),
                                                                maps[c].map, describers[c]));
     e.interrupted = !forEachFrame(frames, "localize", progress, cfg.stop, [&](const Frame& frame) {
-      noteQuery(e, frames.datasetFrame(frame.index), frame, mapped_positions,
-                source.info().rig.T_base_lidar, check);
+      const size_t dataset_frame = frames.datasetFrame(frame.index);
+      noteQuery(e, dataset_frame, frame, mapped, source.info().rig.T_base_lidar);
       for (auto& s : sessions) s->process(frame);
+      if (mapped.scan_context)
+        localizeByScanContext(*mapped.scan_context, frame, dataset_frame, source.info(),
+                              scan_context_run);
     });
     for (size_t c = 0; c < cfg.configs.size(); ++c) {
       LocalizationRun run = sessions[c]->take();
@@ -256,8 +334,13 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
   summarizeCorrections(e);
   for (size_t c = 0; c < cfg.configs.size(); ++c) {
     runs[c].stats.interrupted = e.interrupted;  // its summary.json says so
-    e.results.push_back(resultOf(e, cfg.configs[c], runs[c], maps[c]));
+    e.results.push_back(segmentResultOf(e, cfg.configs[c], runs[c], maps[c]));
     writeRunFiles(cfg.configs[c], runs[c], maps[c], e, out);
+  }
+  if (mapped.scan_context) {
+    scan_context_run.stats.interrupted = e.interrupted;
+    e.results.push_back(scanContextResultOf(e, scan_context_run, *mapped.scan_context));
+    writeScanContextFiles(scan_context_run, e.results.back(), e, out);
   }
 }
 
@@ -287,11 +370,14 @@ nlohmann::ordered_json toJson(const RevisitResult& r) {
                     {"localized_at_frame", w.localized > 0 ? Json(w.localized) : Json(nullptr)},
                     {"wrong_first", w.wrong_first}});
   return {{"config", r.config},
+          {"method", r.method},
           {"descriptor", r.descriptor},
           {"model", r.model},
           {"model_note", r.model_note},
           {"map_segments", r.map_segments},
           {"map_bytes", r.map_bytes},
+          {"mapped_scans", r.mapped_scans},
+          {"ms_per_query", orNull(r.ms_per_query)},
           {"n_localizations", r.localizations.size()},
           {"n_error_below_0_5m", r.below_0_5m},
           {"n_error_below_1m", r.below_1m},
@@ -351,6 +437,18 @@ std::vector<size_t> wakeUpColumns(size_t frames) {
   return out;
 }
 
+// Which method gave a row: the segments and their descriptor, or Scan Context's whole scans.
+std::string methodText(const RevisitResult& r) {
+  return r.method == kScanContextName ? "Scan Context (whole scan)"
+                                      : r.method + " (" + r.descriptor + ")";
+}
+
+std::string msText(const std::optional<double>& ms) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", ms.value_or(0.0));
+  return ms ? text : "-";
+}
+
 // Counted over the wake-ups at a revisit: elsewhere the map holds nothing to localize against.
 std::string wakeUpRow(const RevisitResult& r, const std::vector<size_t>& by) {
   size_t at_revisit = 0, wrong = 0;
@@ -361,9 +459,10 @@ std::string wakeUpRow(const RevisitResult& r, const std::vector<size_t>& by) {
     wrong += w.wrong_first;
     for (size_t i = 0; i < by.size(); ++i) localized[i] += w.localized > 0 && w.localized <= by[i];
   }
-  std::string row = "| " + r.config + " | " + std::to_string(at_revisit) + " |";
+  std::string row =
+      "| " + r.config + " | " + methodText(r) + " | " + std::to_string(at_revisit) + " |";
   for (const size_t n : localized) row += " " + std::to_string(n) + " |";
-  return row + " " + std::to_string(wrong) + " |";
+  return row + " " + std::to_string(wrong) + " | " + msText(r.ms_per_query) + " |";
 }
 
 }  // namespace
@@ -435,14 +534,13 @@ RevisitExperiment evaluateRevisits(FrameSource& source, const RevisitExperimentC
     choices.push_back(chooseDescriptor(c.config.descriptor, input));
     describers.push_back(makeDescriber(choices.back().descriptor));
   }
-  std::vector<Eigen::Vector3d> mapped_positions;
-  std::optional<GroundTruthCheck> check;
-  if (cfg.check_ground_truth) check.emplace();
-  GroundTruthCheck* checking = check ? &*check : nullptr;
-  const std::vector<BuiltMap> maps =
-      buildMaps(source, e, describers, out, mapped_positions, progress, checking);
-  localizeQueries(source, e, describers, maps, mapped_positions, out, progress, checking);
-  for (size_t c = 0; c < e.results.size(); ++c) {
+  MappedScans mapped;
+  if (cfg.check_ground_truth) mapped.check.emplace();
+  if (cfg.scan_context)
+    mapped.scan_context.emplace(*cfg.scan_context, source.info().rig.T_base_lidar);
+  const std::vector<BuiltMap> maps = buildMaps(source, e, describers, out, mapped, progress);
+  localizeQueries(source, e, describers, maps, mapped, out, progress);
+  for (size_t c = 0; c < cfg.configs.size(); ++c) {  // Scan Context's result follows theirs
     e.results[c].model = choices[c].descriptor.model;
     e.results[c].model_note = choices[c].note;
   }
@@ -509,16 +607,17 @@ void writeRevisitFiles(const RevisitExperiment& e, const std::filesystem::path& 
 
 std::string revisitTable(const RevisitExperiment& e) {
   std::ostringstream t;
-  t << "| config | localizations | < 0.5 m | < 1 m | < 5 m | wrong (> " << e.config.wrong_m
-    << " m) | mean error | revisits localized (< " << e.config.correct_m << " m) |\n"
-    << "| --- | ---: | ---: | ---: | ---: | ---: | --- | ---: |\n";
+  t << "| config | method | localizations | < 0.5 m | < 1 m | < 5 m | wrong (> " << e.config.wrong_m
+    << " m) | mean error | revisits localized (< " << e.config.correct_m << " m) | ms / query |\n"
+    << "| --- | --- | ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: |\n";
   char line[512];
   for (const RevisitResult& r : e.results) {
-    std::snprintf(line, sizeof(line), "| %s | %zu | %zu | %zu | %zu | %zu | %s | %zu of %zu |\n",
-                  r.config.c_str(), r.localizations.size(), r.below_0_5m, r.below_1m, r.below_5m,
-                  r.wrong,
+    std::snprintf(line, sizeof(line),
+                  "| %s | %s | %zu | %zu | %zu | %zu | %zu | %s | %zu of %zu | %s |\n",
+                  r.config.c_str(), methodText(r).c_str(), r.localizations.size(), r.below_0_5m,
+                  r.below_1m, r.below_5m, r.wrong,
                   meanErrorText(r.mean_translation_error_m, r.mean_rotation_error_deg).c_str(),
-                  r.revisits_localized, e.revisits);
+                  r.revisits_localized, e.revisits, msText(r.ms_per_query).c_str());
     t << line;
   }
   if (e.odometry_is_ground_truth)
@@ -529,11 +628,11 @@ std::string revisitTable(const RevisitExperiment& e) {
   if (e.config.wake_up_frames > 0) {
     if (e.config.check_ground_truth)
       t << "\nwake-ups judged against the registered ground truth where the scan registered\n";
-    t << "\n| config | wake-ups at a revisit |";
+    t << "\n| config | method | wake-ups at a revisit |";
     const std::vector<size_t> by = wakeUpColumns(e.config.wake_up_frames);
     for (const size_t k : by) t << " localized by frame " << k << " |";
-    t << " first localization wrong |\n| --- | ---: |";
-    for (size_t i = 0; i <= by.size(); ++i) t << " ---: |";
+    t << " first localization wrong | ms / query |\n| --- | --- | ---: |";
+    for (size_t i = 0; i <= by.size() + 1; ++i) t << " ---: |";
     t << "\n";
     for (const RevisitResult& r : e.results) t << wakeUpRow(r, by) << "\n";
   }

@@ -13,6 +13,7 @@
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/eval/experiment.h"
+#include "semsegmap/eval/scan_context_localizer.h"
 #include "semsegmap/pipeline/modes.h"
 
 namespace semsegmap {
@@ -42,6 +43,10 @@ struct RevisitExperimentConfig {
   // (eval/ground_truth_check.h): how far the ground truth disagrees with the map's own geometry,
   // and each localization's error against the registered pose besides the recorded one.
   bool check_ground_truth = false;
+  // Scan Context (eval/scan_context_localizer.h), the whole-scan baseline, on the same frames:
+  // the mapped scans at their ground-truth poses, each query frame on its own (it needs no local
+  // map). Its result follows the configurations', named kScanContextName; nothing: left out.
+  std::optional<ScanContextLocalizerConfig> scan_context = ScanContextLocalizerConfig{};
   // Checked before each frame (Ctrl-C in the CLI): the maps and query sessions end with the
   // frames done, and no further query session starts.
   StopToken stop;
@@ -80,13 +85,24 @@ struct RevisitLocalization {
   double registered_rotation_error_deg = -1.0;
 };
 
-struct RevisitResult {  // one configuration
+// The name of Scan Context's result, and its descriptor's; a configuration may not take it.
+inline constexpr const char* kScanContextName = "scan-context";
+
+struct RevisitResult {  // one configuration, or Scan Context
   std::string config, descriptor;
+  std::string method = "segments";  // what localized: "segments", or kScanContextName
   std::string model;  // the model file the input's modalities chose (chooseDescriptor); or empty
-  std::string model_note;  // why that model, when the configuration names more than one
-  size_t map_segments = 0;
+  std::string model_note;   // why that model, when the configuration names more than one
+  size_t map_segments = 0;  // Scan Context: 0
+  // The saved map's file; Scan Context: what it keeps in memory, the scan contexts and the mapped
+  // scans' points it registers to.
   uint64_t map_bytes = 0;
+  size_t mapped_scans = 0;  // Scan Context: the scans in its database
   std::vector<RevisitLocalization> localizations;
+  // Mean time a query frame took, ms: with segments the front end and the localization (the
+  // pipeline's stage times), with Scan Context the scan context, the retrieval and the
+  // registration. None: no query frame.
+  std::optional<double> ms_per_query;
   size_t below_0_5m = 0, below_1m = 0, below_5m = 0, wrong = 0;
   std::optional<double> mean_translation_error_m, mean_rotation_error_deg;  // none: unknown
   size_t revisits_localized = 0;  // revisit frames localized within correct_m
