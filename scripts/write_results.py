@@ -20,7 +20,7 @@ renamed, so an interrupted run leaves the old one whole. KIND says what the inpu
   memory        LABEL=rss.csv of `semsegmap_memory_run`: the resident set per kilometre
   segments      LABEL=segments.csv of `semsegmap segment`: count, size and purity
   odometry      LABEL=summary.json of `semsegmap odometry`: KITTI errors and ATE
-  revisits      revisits.json of `semsegmap eval revisits`: a row per config
+  revisits      revisits.json of `semsegmap eval revisits`: a row per config and Scan Context
   wake-ups      revisits.json of `eval revisits --wake-up`: localized by frame N
   registration  Google Benchmark JSON: the odometry's registration against the libraries'
   slam          LABEL=summary.json of `semsegmap slam`: loop closures and trajectory errors
@@ -352,19 +352,36 @@ def load_revisits(path):
     return load_json(path, "results", "a revisits.json of semsegmap eval revisits")
 
 
+def revisit_method(r):
+    """Which method gave a row: the segments and their descriptor, or Scan Context's whole
+    scans. Files written before Scan Context have segment rows alone, and no method."""
+    method = r.get("method", "segments")
+    if method == "scan-context":
+        return "Scan Context (whole scan)"
+    return f"{method} ({r['descriptor']})"
+
+
+def ms_per_query(r):
+    ms = r.get("ms_per_query")
+    return "-" if ms is None else f"{ms:.1f}"
+
+
 def revisits_table(inputs):
-    header = [("config", 0), ("localizations", 1), ("< 0.5 m", 1), ("< 1 m", 1), ("< 5 m", 1),
-              ("wrong (> 5 m)", 1), ("mean error", 0), ("revisits localized (< 1 m)", 1),
-              ("registered truth < 0.3 m", 1)]
+    header = [("config", 0), ("method", 0), ("localizations", 1), ("< 0.5 m", 1), ("< 1 m", 1),
+              ("< 5 m", 1), ("wrong (> 5 m)", 1), ("mean error", 0),
+              ("revisits localized (< 1 m)", 1), ("registered truth < 0.3 m", 1),
+              ("ms / query", 1)]
     rows = []
     for path in inputs:
         e = load_revisits(path)
         for r in e["results"]:
             compared = r.get("n_registered_compared") or 0
-            rows.append([r["config"], r["n_localizations"], r["n_error_below_0_5m"],
-                         r["n_error_below_1m"], r["n_error_below_5m"], r["n_wrong"],
-                         mean_error(r), f"{r['n_revisits_localized']} of {e['n_revisits']}",
-                         f"{r['n_registered_below_0_3m']} of {compared}" if compared else "-"])
+            rows.append([r["config"], revisit_method(r), r["n_localizations"],
+                         r["n_error_below_0_5m"], r["n_error_below_1m"], r["n_error_below_5m"],
+                         r["n_wrong"], mean_error(r),
+                         f"{r['n_revisits_localized']} of {e['n_revisits']}",
+                         f"{r['n_registered_below_0_3m']} of {compared}" if compared else "-",
+                         ms_per_query(r)])
     return table(header, rows)
 
 
@@ -372,8 +389,9 @@ WAKE_UP_BY = (1, 2, 3, 5, 10)
 
 
 def wake_ups_table(inputs):
-    header = ([("config", 0), ("wake-ups at a revisit", 1)] +
-              [(f"by frame {k}", 1) for k in WAKE_UP_BY] + [("first localization wrong", 1)])
+    header = ([("config", 0), ("method", 0), ("wake-ups at a revisit", 1)] +
+              [(f"by frame {k}", 1) for k in WAKE_UP_BY] + [("first localization wrong", 1),
+                                                            ("ms / query", 1)])
     rows = []
     for path in inputs:
         for r in load_revisits(path)["results"]:
@@ -383,7 +401,8 @@ def wake_ups_table(inputs):
             by = [sum(1 for w in at_revisit if w["localized_at_frame"] is not None
                       and w["localized_at_frame"] <= k) for k in WAKE_UP_BY]
             wrong = sum(1 for w in r["wake_ups"] if w["wrong_first"])
-            rows.append([r["config"], len(at_revisit), *by, wrong])
+            rows.append([r["config"], revisit_method(r), len(at_revisit), *by, wrong,
+                         ms_per_query(r)])
     return table(header, rows)
 
 
