@@ -235,8 +235,9 @@ void summarizeCorrections(RevisitExperiment& e) {
   if (e.registered > 0) e.mean_correction_m /= static_cast<double>(e.registered);
 }
 
-// Scan Context's localization of one query frame, on its own, recorded into `run` as the
-// sessions record theirs (under the dataset's frame number), its time as the localization's.
+// Scan Context's localization of one query frame, on its own, recorded into the session's `run`
+// as the sessions record theirs (under the dataset's frame number), its time as the
+// localization's.
 void localizeByScanContext(const ScanContextLocalizer& scan_context, const Frame& frame,
                            size_t dataset_frame, const DatasetInfo& info, LocalizationRun& run) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -244,6 +245,9 @@ void localizeByScanContext(const ScanContextLocalizer& scan_context, const Frame
   run.stats.total.localize_ms +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ++run.stats.frames;
+  if (!run.trajectory_odom.empty())  // driven, as a session counts it
+    run.distance_m +=
+        (frame.T_odom_base.translation() - run.trajectory_odom.back().translation()).norm();
   run.frames.push_back(stampOf(frame, info));
   run.trajectory_odom.push_back(frame.T_odom_base);
   if (frame.T_world_base) run.trajectory_gt.push_back(*frame.T_world_base);
@@ -312,6 +316,7 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
     if (e.interrupted) break;  // no session starts after the stop request
     FrameSubset frames(source, framesOf(ranges));
     std::vector<std::unique_ptr<LocalizationSession>> sessions;
+    LocalizationRun scan_context_session;
     for (size_t c = 0; c < cfg.configs.size(); ++c)
       sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source.info(),
                                                                maps[c].map, describers[c]));
@@ -321,8 +326,9 @@ void localizeQueries(FrameSource& source, RevisitExperiment& e,
       for (auto& s : sessions) s->process(frame);
       if (mapped.scan_context)
         localizeByScanContext(*mapped.scan_context, frame, dataset_frame, source.info(),
-                              scan_context_run);
+                              scan_context_session);
     });
+    appendRun(scan_context_run, std::move(scan_context_session));
     for (size_t c = 0; c < cfg.configs.size(); ++c) {
       LocalizationRun run = sessions[c]->take();
       // Reported under the dataset's frame numbers, not the subset's.
