@@ -97,7 +97,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"world-seed", "map"}},
     {"localize",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "map", "out",
-      "max-frames", "allow-config-mismatch"},
+      "max-frames", "allow-config-mismatch", "relocalize", "prior"},
      {"poses", "float32"}},
     {"slam",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
@@ -971,7 +971,7 @@ TEST(CliPoseFiles, WithoutGroundTruthOrTimesNothingIsMadeUp) {
   EXPECT_NE(l.out.find("(no ground truth: errors unknown)"), std::string::npos) << l.out;
   EXPECT_EQ(l.out.find("<1 m"), std::string::npos) << l.out;
   const std::string summary = readFile(dir / "loc" / "summary.json");
-  EXPECT_NE(summary.find("\"schema\": \"semsegmap.localization/2\""), std::string::npos);
+  EXPECT_NE(summary.find("\"schema\": \"semsegmap.localization/3\""), std::string::npos);
   EXPECT_NE(summary.find("\"n_error_below_1m\": null"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"n_error_below_5m\": null"), std::string::npos) << summary;
   const std::vector<std::string> header = csvLine(dir / "loc" / "localizations.csv", 0);
@@ -984,6 +984,51 @@ TEST(CliPoseFiles, WithoutGroundTruthOrTimesNothingIsMadeUp) {
   EXPECT_EQ(second[0], "1");
   EXPECT_EQ(second[1], "2");
   EXPECT_EQ(second[2], "");
+}
+
+// localize --relocalize: a map without segment points is refused before any frame, --prior needs
+// --relocalize and two or three numbers, and localizations.csv says which path gave each pose.
+TEST(CliPoseFiles, RelocalizeChecksItsMapAndPriorAndNamesEachPath) {
+  if (!built("simulate")) GTEST_SKIP() << "the data comes from the simulator";
+  TempDir tmp;
+  const std::filesystem::path dir = tmp.path(), data = scansWithout(dir, "000001.bin");
+  const std::string config = " --config " + eigenConfig(dir, "eigen.yaml");
+  const std::string scans = " --dataset folder:" + (data / "lidar").string() + " --odometry " +
+                            (dir / "odom.txt").string();
+  const std::string bare = (dir / "bare.map").string(), dense = (dir / "dense.map").string();
+  ASSERT_EQ(run("map" + scans + config + " --out " + bare).code, 0);
+  const std::string localize = "localize" + scans + config + " --out " + (dir / "loc").string();
+  const Result no_points = run(localize + " --map " + bare + " --relocalize");
+  EXPECT_EQ(no_points.code, 1);
+  EXPECT_NE(no_points.err.find("bare.map: stores no segment points, which "
+                               "localization.relocalization needs"),
+            std::string::npos)
+      << no_points.err;
+  const Result prior_alone = run(localize + " --map " + bare + " --prior 1,2");
+  EXPECT_EQ(prior_alone.code, 2);
+  EXPECT_NE(prior_alone.err.find("--prior narrows a relocalization: give --relocalize too"),
+            std::string::npos);
+  for (const char* bad : {"1,x", "1", "1,2,3,4", "1,2,-5"}) {
+    const Result r = run(localize + " --map " + bare + " --relocalize --prior " + bad);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.err.find("--prior: expected X,Y"), std::string::npos) << r.err;
+  }
+  ASSERT_EQ(run("map" + scans + config + " --points 512 --out " + dense).code, 0);
+  const Result ok = run(localize + " --map " + dense + " --relocalize --prior 0,0,500");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const std::vector<std::string> header = csvLine(dir / "loc" / "localizations.csv", 0);
+  ASSERT_GE(header.size(), 2u);
+  EXPECT_EQ(header[header.size() - 2], "path");
+  EXPECT_EQ(header.back(), "fitness");
+  const std::string summary = readFile(dir / "loc" / "summary.json");
+  EXPECT_NE(summary.find("\"n_by_path\""), std::string::npos) << summary;
+  for (size_t row = 1;; ++row) {
+    const std::vector<std::string> line = csvLine(dir / "loc" / "localizations.csv", row);
+    if (line.size() < header.size()) break;
+    const std::string path = line[header.size() - 2];
+    EXPECT_TRUE(path == "local-map" || path == "latest-scan" || path == "relocalization") << path;
+    EXPECT_EQ(line.back().empty(), path != "relocalization") << row;
+  }
 }
 
 // slam and odometry on data without frame times write no TUM file (its times would be made up

@@ -14,6 +14,7 @@
 #include <random>
 
 #include "build_options.h"
+#include "error_text.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/diagnostics.h"
@@ -243,9 +244,52 @@ TEST(Modes, ScansFarApartLocalizeFromTheLatestScanWhenTheLocalMapDoesNot) {
   ASSERT_EQ(with.localizations.size(), 1u);
   const LocalizationRecord& r = with.localizations[0];
   EXPECT_EQ(r.frame_index, 1u);
-  EXPECT_TRUE(r.latest_scan);
+  EXPECT_EQ(r.path, LocalizationPath::kLatestScan);
   EXPECT_LT(r.translation_error_m, 0.05);
   EXPECT_LT(r.rotation_error_deg, 0.25);  // 0.19: the points no camera saw are in its segments
+}
+
+// localization.relocalization: a robot wakes up (one scan of S2) in a map of S1. The whole-map
+// query is made to ask for more consistent matches than one scan gives, so only the
+// relocalization path (places voted for, fewer inliers, the registration check) can localize it;
+// a map without segment points is refused before any frame, and a prior elsewhere finds nothing.
+TEST(Modes, AWakeUpIsRelocalizedFromOneScanAndThePathIsRecorded) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  PipelineConfig config = semsegmapConfig();
+  config.target_map.max_points_per_segment = 512;
+  const auto describer = std::make_shared<OracleDescriber>();
+  auto mapped = openDataset("sim:world=1,run=S1,preset=tiny,frames=80");
+  const auto map = std::make_shared<const TargetMap>(
+      runMapping(*mapped, config, PoseSource::kGroundTruth, describer).map);
+  auto run = openDataset("sim:world=1,run=S2,preset=tiny,frames=80");
+  FrameSubset wake_up(*run, {15});  // on S1's street, S1 drove past 25 frames in
+  config.localization.localizer.verification.min_inliers = 1000;
+  EXPECT_TRUE(runLocalization(wake_up, config, map, describer).localizations.empty());
+
+  config.localization.relocalization.enabled = true;
+  const LocalizationRun with = runLocalization(wake_up, config, map, describer);
+  ASSERT_EQ(with.localizations.size(), 1u);
+  const LocalizationRecord& r = with.localizations[0];
+  EXPECT_EQ(r.path, LocalizationPath::kRelocalization);
+  ASSERT_TRUE(r.registration_fitness);
+  EXPECT_GE(*r.registration_fitness, config.localization.relocalization.check.min_fitness);
+  EXPECT_LT(r.translation_error_m, 0.3);
+  EXPECT_LT(r.rotation_error_deg, 1.0);
+
+  const RelocalizationPrior elsewhere{r.T_map_base.translation() + Eigen::Vector3d(300, 0, 0),
+                                      50.0};
+  EXPECT_TRUE(
+      runLocalization(wake_up, config, map, describer, {}, MapSettingsCheck::kRefuse, elsewhere)
+          .localizations.empty());
+
+  TargetMap bare = *map;
+  for (MapSegment& s : bare.segments) s.points.clear();
+  bare.source = "bare.map";
+  const std::string error = test_support::errorOf([&] {
+    runLocalization(wake_up, config, std::make_shared<const TargetMap>(bare), describer);
+  });
+  EXPECT_MENTIONS(error, "bare.map: stores no segment points, which localization.relocalization");
+  EXPECT_ONE_LINE(error);
 }
 
 // Segments leave the local map finished (their views go into the map), absorbed (their views go
@@ -293,7 +337,7 @@ TEST(Modes, SummaryWithoutGroundTruthHasNullCountsAndErrors) {
   r.inliers = 7;
   run.localizations.assign(2, r);
   const std::string json = localizationSummaryJson(run, SummaryContext{});
-  EXPECT_NE(json.find("\"schema\": \"semsegmap.localization/2\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"schema\": \"semsegmap.localization/3\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"n_localizations\": 2"), std::string::npos) << json;
   EXPECT_NE(json.find("\"n_with_ground_truth\": 0"), std::string::npos) << json;
   for (const char* key : {"n_error_below_1m", "n_error_below_5m", "mean_translation_error_m",

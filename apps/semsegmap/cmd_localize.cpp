@@ -1,7 +1,13 @@
 // semsegmap localize: localizes a run against a saved target map; writes localizations.csv,
 // matches.csv and trajectory.csv (for semsegmap view), summary.json and a bird's-eye picture.
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "cli_args.h"
 #include "dataset_args.h"
@@ -41,8 +47,31 @@ void printLocalizationSummary(const LocalizationRun& run) {
   std::printf("\n");
 }
 
+// --prior X,Y[,RADIUS]: where the robot is known to be, in the map frame (radius 50 m).
+std::optional<RelocalizationPrior> priorOf(const CliArgs& a, const PipelineConfig& config) {
+  if (!a.has("prior")) return std::nullopt;
+  if (!config.localization.relocalization.enabled)
+    throw UsageError("--prior narrows a relocalization: give --relocalize too");
+  std::vector<double> v;
+  std::stringstream text(a.get("prior"));
+  for (std::string item; std::getline(text, item, ',');) {
+    char* end = nullptr;
+    v.push_back(std::strtod(item.c_str(), &end));
+    if (item.empty() || *end != '\0' || !std::isfinite(v.back()))
+      throw UsageError("--prior: expected X,Y or X,Y,RADIUS in metres, got " + a.get("prior"));
+  }
+  if (v.size() < 2 || v.size() > 3 || (v.size() == 3 && v[2] <= 0))
+    throw UsageError("--prior: expected X,Y or X,Y,RADIUS (RADIUS > 0), got " + a.get("prior"));
+  RelocalizationPrior prior;
+  prior.position = Eigen::Vector3d(v[0], v[1], 0.0);
+  if (v.size() == 3) prior.radius_m = v[2];
+  return prior;
+}
+
 int runLocalize(const CliArgs& a) {
-  const PipelineConfig config = loadPipelineConfig(a.get("config"));
+  PipelineConfig config = loadPipelineConfig(a.get("config"));
+  if (a.has("relocalize")) config.localization.relocalization.enabled = true;
+  const std::optional<RelocalizationPrior> prior = priorOf(a, config);
   const std::filesystem::path map_path = a.get("map");
   const std::filesystem::path out = a.get("out");
   const auto map = std::make_shared<const TargetMap>(loadTargetMap(map_path));
@@ -73,7 +102,8 @@ int runLocalize(const CliArgs& a) {
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   options.stop = stopToken();
   options.stages = data.stages;
-  const LocalizationRun run = runLocalization(*source, config, map, describer, options, settings);
+  const LocalizationRun run =
+      runLocalization(*source, config, map, describer, options, settings, prior);
   // Stopped before its first frame: nothing worth writing (main removes what the run made).
   if (run.stats.interrupted && run.stats.frames == 0)
     return interruptedRun("localize", 0, options.frameCount(*source), out.string());
@@ -117,6 +147,11 @@ const CommandSpec& localizeCommand() {
               maxFramesOption(),
               {"allow-config-mismatch", Value::kFlag, "", "",
                "localize even when the map was built with other settings (listed on stderr)"},
+              {"relocalize", Value::kFlag, "", "",
+               "search the whole map when not localized for a while "
+               "(localization.relocalization; the map needs segment points)"},
+              {"prior", Value::kText, "X,Y[,RADIUS]", "",
+               "relocalize only within RADIUS m (default 50) of X,Y in the map frame"},
           }),
       kDatasetNotes,
       runLocalize,

@@ -229,12 +229,41 @@ class RefinementConfig:
     neighbours_m: float
     def __init__(self, **fields: object) -> None: ...
 
+class RegistrationCheckConfig:
+    _fields: tuple[str, ...]
+    max_points_per_segment: int
+    coarse_distance_m: float
+    fine_distance_m: float
+    kernel_scale_m: float
+    near_m: float
+    min_fitness: float
+    min_points: int
+    max_correction_m: float
+    max_correction_deg: float
+    place_radius_m: float
+    def __init__(self, **fields: object) -> None: ...
+
+class RelocalizationConfig:
+    _fields: tuple[str, ...]
+    enabled: bool
+    after_m: float
+    k: int
+    k_in_place: int
+    place_radius_m: float
+    cell_m: float
+    max_places: int
+    min_votes: int
+    verification: GeometricVerificationConfig
+    check: RegistrationCheckConfig
+    def __init__(self, **fields: object) -> None: ...
+
 class LocalizationConfig:
     _fields: tuple[str, ...]
     localizer: LocalizerConfig
     every_n_frames: int
     latest_scan_fallback_m: float
     refinement: RefinementConfig
+    relocalization: RelocalizationConfig
     def __init__(self, **fields: object) -> None: ...
 
 class TargetMapBuilderConfig:
@@ -565,7 +594,9 @@ class LocalizationRecord:
     @property
     def refinement_correction_m(self) -> float: ...
     @property
-    def latest_scan(self) -> bool: ...
+    def path(self) -> str: ...
+    @property
+    def registration_fitness(self) -> Optional[float]: ...
 
 class LocalizationSummary:
     def __repr__(self) -> str: ...

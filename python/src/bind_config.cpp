@@ -83,11 +83,36 @@ void bindLocalizationConfigs(py::module_& m) {
       .field("max_correction_m", &RefinementConfig::max_correction_m)
       .field("min_correspondences", &RefinementConfig::min_correspondences)
       .field("neighbours_m", &RefinementConfig::neighbours_m);
+  using RC = RegistrationCheckConfig;
+  StructBinding<RC>(m, "RegistrationCheckConfig", "localize/registration_check.h")
+      .field("max_points_per_segment", &RC::max_points_per_segment)
+      .field("coarse_distance_m", &RC::coarse_distance_m)
+      .field("fine_distance_m", &RC::fine_distance_m)
+      .field("kernel_scale_m", &RC::kernel_scale_m)
+      .field("near_m", &RC::near_m)
+      .field("min_fitness", &RC::min_fitness)
+      .field("min_points", &RC::min_points)
+      .field("max_correction_m", &RC::max_correction_m)
+      .field("max_correction_deg", &RC::max_correction_deg)
+      .field("place_radius_m", &RC::place_radius_m);
+  using RL = RelocalizationConfig;
+  StructBinding<RL>(m, "RelocalizationConfig", "localize/relocalizer.h")
+      .field("enabled", &RL::enabled)
+      .field("after_m", &RL::after_m)
+      .field("k", &RL::k)
+      .field("k_in_place", &RL::k_in_place)
+      .field("place_radius_m", &RL::place_radius_m)
+      .field("cell_m", &RL::cell_m)
+      .field("max_places", &RL::max_places)
+      .field("min_votes", &RL::min_votes)
+      .field("verification", &RL::verification)
+      .field("check", &RL::check);
   StructBinding<LocalizationConfig>(m, "LocalizationConfig", "pipeline/pipeline_config.h")
       .field("localizer", &LocalizationConfig::localizer)
       .field("every_n_frames", &LocalizationConfig::every_n_frames)
       .field("latest_scan_fallback_m", &LocalizationConfig::latest_scan_fallback_m)
-      .field("refinement", &LocalizationConfig::refinement);
+      .field("refinement", &LocalizationConfig::refinement)
+      .field("relocalization", &LocalizationConfig::relocalization);
   using TMB = TargetMapBuilderConfig;
   StructBinding<TMB>(m, "TargetMapBuilderConfig", "localize/target_map.h")
       .field("duplicate_distance_m", &TMB::duplicate_distance_m)

@@ -395,8 +395,12 @@ void bindLocalizationRecord(py::module_& m) {
           "(K, 2, 3) float32: the local centroid carried into the map, the target's")
       .def_readonly("refined", &LocalizationRecord::refined)
       .def_readonly("refinement_correction_m", &LocalizationRecord::refinement_correction_m)
-      .def_readonly("latest_scan", &LocalizationRecord::latest_scan,
-                    "localized by the latest scan's own segments (latest_scan_fallback_m)");
+      .def_property_readonly(
+          "path", [](const LocalizationRecord& r) { return localizationPathName(r.path); },
+          "which segments localized: 'local-map', 'latest-scan' (latest_scan_fallback_m) or "
+          "'relocalization' (localization.relocalization)")
+      .def_readonly("registration_fitness", &LocalizationRecord::registration_fitness,
+                    "a relocalization's share of local points on the map's; None otherwise");
 }
 
 void bindLocalizationResults(py::module_& m) {

@@ -67,12 +67,14 @@ void writeTrajectoryCsv(const std::filesystem::path& path, const SlamRun& run) {
 
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
-    // The columns of schema semsegmap.localization/2 (summary.json; docs/commands.md), read by
-    // name: dataset_frame and an empty timestamp are what version 1 lacked.
+    // The columns of schema semsegmap.localization/3 (summary.json; docs/commands.md), read by
+    // name: dataset_frame and an empty timestamp are what version 1 lacked, path and fitness
+    // what version 2 lacked (its latest_scan column is path = latest-scan).
     // refinement_m: how far pose refinement moved the pose; empty where it was not applied.
-    // latest_scan: 1 where the latest scan's own segments localized (latest_scan_fallback_m).
+    // path: which segments localized (local-map, latest-scan, relocalization); fitness: a
+    // relocalization's registration check, empty for the other paths.
     out << "frame,dataset_frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,"
-           "rotation_error_deg,refinement_m,latest_scan\n";
+           "rotation_error_deg,refinement_m,path,fitness\n";
     char line[512];
     for (const LocalizationRecord& r : run.localizations) {
       const auto v = toXyzQuat(r.T_map_base);
@@ -93,7 +95,12 @@ void writeLocalizationsCsv(const std::filesystem::path& path, const Localization
       } else {
         out << ',';
       }
-      out << ',' << (r.latest_scan ? 1 : 0) << '\n';
+      out << ',' << localizationPathName(r.path) << ',';
+      if (r.registration_fitness) {
+        std::snprintf(line, sizeof(line), "%.3f", *r.registration_fitness);
+        out << line;
+      }
+      out << '\n';
     }
   });
 }
@@ -138,6 +145,13 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
   j["n_error_below_5m"] = orNull(s.below_5m);
   j["n_refined"] = std::count_if(run.localizations.begin(), run.localizations.end(),
                                  [](const LocalizationRecord& r) { return r.refined; });
+  nlohmann::ordered_json by_path;
+  for (LocalizationPath p : {LocalizationPath::kLocalMap, LocalizationPath::kLatestScan,
+                             LocalizationPath::kRelocalization})
+    by_path[localizationPathName(p)] =
+        std::count_if(run.localizations.begin(), run.localizations.end(),
+                      [p](const LocalizationRecord& r) { return r.path == p; });
+  j["n_by_path"] = by_path;
   j["mean_translation_error_m"] = orNull(s.mean_translation_error_m);
   j["mean_rotation_error_deg"] = orNull(s.mean_rotation_error_deg);
   j["fps"] = run.stats.fps();

@@ -20,13 +20,14 @@ namespace semsegmap {
 
 // The version of localizations.csv and summary.json, named in summary.json: 2 added the
 // dataset's own frame number and left a time the data does not have empty (1 made one up), and
-// writes null for every error or count the run does not know.
-inline constexpr const char* kLocalizationSchema = "semsegmap.localization/2";
+// writes null for every error or count the run does not know; 3 says which path localized
+// (local-map, latest-scan, relocalization) and a relocalization's fitness, and counts them.
+inline constexpr const char* kLocalizationSchema = "semsegmap.localization/3";
 
 // frame (the run's index), dataset_frame (the dataset's own number, empty when it has none),
 // timestamp (the data's, empty when it has none), T_map_base as x y z qx qy qz qw, inliers, with
-// ground truth the translation error in m and the rotation error in degrees, refinement_m and
-// latest_scan.
+// ground truth the translation error in m and the rotation error in degrees, refinement_m, path
+// and fitness.
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run);
 
 // ",NUMBER,TIME" with either field empty when unknown: the dataset's name of a frame as the

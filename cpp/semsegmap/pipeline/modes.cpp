@@ -186,6 +186,12 @@ std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map
     throw std::invalid_argument(
         "the target map stores no segment points, which localization.refinement needs: build "
         "it with target_map.max_points_per_segment (map --points N) or turn refinement off");
+  if (config.localization.relocalization.enabled && !hasSegmentPoints(*map))
+    throw std::invalid_argument(
+        name +
+        ": stores no segment points, which localization.relocalization needs to check a "
+        "pose: build it with target_map.max_points_per_segment (map --points N) or turn "
+        "relocalization off");
   return map;
 }
 }  // namespace
@@ -217,20 +223,46 @@ void LocalizationSession::process(const Frame& frame) {
   const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
   if (frames_++ % every == 0) {
     const auto t0 = std::chrono::steady_clock::now();
-    Attempt a = attempt(pipeline_);
-    Pose T_map_base = Pose::Identity();
-    const double fallback_m = config_.localization.latest_scan_fallback_m;
-    const bool latest_scan = !a.found && fallback_m > 0 && moved >= fallback_m;
-    if (a.found)
-      T_map_base = a.found->T_map_local * r.T_local_base;
-    else if (latest_scan)  // the scan as the front-end stages left it: labelled and posed
-      a = attemptLatestScan(pipeline_.processedFrame(frame), T_map_base);
+    const Outcome o = localizeFrame(frame, r.T_local_base, moved);
     r.times.localize_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (a.found) record(frame, T_map_base, a, latest_scan);
+    if (o.attempt.found) {
+      record(frame, o.T_map_base, o.attempt, o.path);
+      localized_at_m_ = run_.distance_m;
+    }
   }
   run_.stats.total += r.times;
   ++run_.stats.frames;
+}
+
+// The local map's segments first; then, when the scan lies far from the one before, its own
+// segments (localization.latest_scan_fallback_m); then, when the robot has not been localized
+// for a while, those of the last try against the whole map (localization.relocalization).
+LocalizationSession::Outcome LocalizationSession::localizeFrame(const Frame& frame,
+                                                                const Pose& T_local_base,
+                                                                double moved) const {
+  Outcome o;
+  o.attempt = attempt(pipeline_);
+  const Pipeline* tried = &pipeline_;
+  Pose base = T_local_base;
+  std::optional<Pipeline> scan;
+  const double fallback_m = config_.localization.latest_scan_fallback_m;
+  if (!o.attempt.found && fallback_m > 0 && moved >= fallback_m) {
+    scan.emplace(config_, info_, PoseSource::kOdometry, describer_);
+    // The scan as the front-end stages left it: labelled and posed.
+    base = scan->process(pipeline_.processedFrame(frame)).T_local_base;
+    o.attempt = attempt(*scan);
+    o.path = LocalizationPath::kLatestScan;
+    tried = &*scan;
+  }
+  const RelocalizationConfig& reloc = config_.localization.relocalization;
+  if (!o.attempt.found && reloc.enabled &&
+      (localized_at_m_ < 0 || run_.distance_m - localized_at_m_ >= reloc.after_m)) {
+    o.attempt = attemptRelocalization(*tried, base);
+    o.path = LocalizationPath::kRelocalization;
+  }
+  if (o.attempt.found) o.T_map_base = o.attempt.found->T_map_local * base;
+  return o;
 }
 
 LocalizationSession::Attempt LocalizationSession::attempt(const Pipeline& pipeline) const {
@@ -244,12 +276,19 @@ LocalizationSession::Attempt LocalizationSession::attempt(const Pipeline& pipeli
   return a;
 }
 
-LocalizationSession::Attempt LocalizationSession::attemptLatestScan(const Frame& frame,
-                                                                    Pose& T_map_base) const {
-  Pipeline scan(config_, info_, PoseSource::kOdometry, describer_);
-  const FrameResult r = scan.process(frame);
-  Attempt a = attempt(scan);
-  if (a.found) T_map_base = a.found->T_map_local * r.T_local_base;
+LocalizationSession::Attempt LocalizationSession::attemptRelocalization(
+    const Pipeline& pipeline, const Pose& T_local_base) const {
+  Attempt a;
+  a.query = pipeline.localSegmentQuery();
+  std::vector<std::vector<Eigen::Vector3f>> points(a.query.ids.size());
+  for (size_t i = 0; i < points.size(); ++i) points[i] = pipeline.observedPoints(a.query.ids[i]);
+  const std::optional<Relocalization> r =
+      relocalize(localizer_, a.query.centroids, a.query.descriptors, points,
+                 T_local_base.translation(), config_.localization.relocalization, prior_);
+  if (r) {
+    a.found = r->match;
+    a.fitness = r->check.fitness;
+  }
   return a;
 }
 
@@ -267,7 +306,7 @@ Refinement LocalizationSession::refine(const Pipeline& pipeline, const Localizat
 }
 
 void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, const Attempt& a,
-                                 bool latest_scan) {
+                                 LocalizationPath path) {
   const Localization& l = *a.found;
   LocalizationRecord rec;
   rec.frame_index = frame.index;
@@ -277,7 +316,8 @@ void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, con
   rec.T_map_base = T_map_base;
   rec.inliers = l.inliers;
   rec.candidates = l.candidates;
-  rec.latest_scan = latest_scan;
+  rec.path = path;
+  rec.registration_fitness = a.fitness;
   if (frame.T_world_base) {
     rec.T_world_base = *frame.T_world_base;
     rec.translation_error_m = translationError(rec.T_map_base, *frame.T_world_base);
@@ -294,12 +334,26 @@ void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, con
   run_.localizations.push_back(std::move(rec));
 }
 
+const char* localizationPathName(LocalizationPath path) {
+  switch (path) {
+    case LocalizationPath::kLocalMap:
+      return "local-map";
+    case LocalizationPath::kLatestScan:
+      return "latest-scan";
+    case LocalizationPath::kRelocalization:
+      return "relocalization";
+  }
+  return "?";
+}
+
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
                                 std::shared_ptr<const TargetMap> map,
                                 std::shared_ptr<Describer> describer, const RunOptions& options,
-                                MapSettingsCheck settings) {
+                                MapSettingsCheck settings,
+                                std::optional<RelocalizationPrior> prior) {
   LocalizationSession session(config, source.info(), std::move(map), std::move(describer), settings,
                               options.stages);
+  session.setPrior(std::move(prior));
   const bool whole = feed(source, options, session);
   LocalizationRun run = session.take();
   run.stats.interrupted = !whole;

@@ -91,6 +91,12 @@ class MappingSession {
 MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSource poses,
                       std::shared_ptr<Describer> describer, const RunOptions& options = {});
 
+// Which segments gave a localization: the local map's, the latest scan's own
+// (localization.latest_scan_fallback_m), or those of a relocalization against the whole map
+// (localization.relocalization).
+enum class LocalizationPath { kLocalMap, kLatestScan, kRelocalization };
+const char* localizationPathName(LocalizationPath path);  // "local-map", ...
+
 struct LocalizationRecord {
   size_t frame_index = 0;              // in the run, from 0 (Frame::index)
   std::optional<size_t> frame_number;  // the dataset's own (Frame::number), when it has one
@@ -107,8 +113,9 @@ struct LocalizationRecord {
   // Pose refinement (localization.refinement): whether it moved T_map_base, and by how much.
   bool refined = false;
   double refinement_correction_m = 0.0;
-  // Localized by the latest scan's own segments (localization.latest_scan_fallback_m).
-  bool latest_scan = false;
+  LocalizationPath path = LocalizationPath::kLocalMap;
+  // Relocalization: the share of the local points that lie on the map's after registration.
+  std::optional<double> registration_fitness;
 };
 
 struct LocalizationRun {
@@ -134,6 +141,9 @@ class LocalizationSession {
                       MapSettingsCheck settings = MapSettingsCheck::kRefuse,
                       const FrontEndStages& stages = {});
   void process(const Frame& frame);
+  // Where the robot is known to be (a GNSS fix, the last saved pose, a user's guess): a
+  // relocalization then only searches the map within the prior's radius. Nothing: everywhere.
+  void setPrior(std::optional<RelocalizationPrior> prior) { prior_ = std::move(prior); }
   const LocalizationRun& run() const { return run_; }
   LocalizationRun take() { return std::move(run_); }
 
@@ -142,15 +152,20 @@ class LocalizationSession {
   struct Attempt {
     std::optional<Localization> found;
     std::optional<Refinement> refined;
+    std::optional<double> fitness;  // of a relocalization's registration check
     LocalSegmentQuery query;
   };
   Attempt attempt(const Pipeline& pipeline) const;
-  // The latest scan's own segments (localization.latest_scan_fallback_m); `T_map_base` is set
-  // when they localize.
-  Attempt attemptLatestScan(const Frame& frame, Pose& T_map_base) const;
+  Attempt attemptRelocalization(const Pipeline& pipeline, const Pose& T_local_base) const;
+  struct Outcome {
+    Attempt attempt;
+    LocalizationPath path = LocalizationPath::kLocalMap;
+    Pose T_map_base = Pose::Identity();
+  };
+  Outcome localizeFrame(const Frame& frame, const Pose& T_local_base, double moved) const;
   Refinement refine(const Pipeline& pipeline, const Localization& l,
                     const LocalSegmentQuery& q) const;
-  void record(const Frame& frame, const Pose& T_map_base, const Attempt& a, bool latest_scan);
+  void record(const Frame& frame, const Pose& T_map_base, const Attempt& a, LocalizationPath path);
   PipelineConfig config_;
   DatasetInfo info_;
   std::shared_ptr<Describer> describer_;
@@ -158,13 +173,16 @@ class LocalizationSession {
   Pipeline pipeline_;
   LocalizationRun run_;
   size_t frames_ = 0;
+  double localized_at_m_ = -1.0;  // run_.distance_m at the last localization; < 0: none yet
+  std::optional<RelocalizationPrior> prior_;
 };
 
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
                                 std::shared_ptr<const TargetMap> map,
                                 std::shared_ptr<Describer> describer,
                                 const RunOptions& options = {},
-                                MapSettingsCheck settings = MapSettingsCheck::kRefuse);
+                                MapSettingsCheck settings = MapSettingsCheck::kRefuse,
+                                std::optional<RelocalizationPrior> prior = std::nullopt);
 
 struct LocalizationSummary {
   size_t localizations = 0;

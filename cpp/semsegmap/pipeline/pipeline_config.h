@@ -9,6 +9,7 @@
 #include "semsegmap/local_map/local_map.h"
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/pose_refinement.h"
+#include "semsegmap/localize/relocalizer.h"
 #include "semsegmap/localize/target_map.h"
 #include "semsegmap/segment/semantic_distance.h"
 
@@ -36,6 +37,8 @@ struct LocalizationConfig {
   // Off by default: it needs a target map with segment points (target_map.
   // max_points_per_segment), which costs 6 bytes a point.
   RefinementConfig refinement;
+  // When neither localizes: one scan against the whole map (localize/relocalizer.h).
+  RelocalizationConfig relocalization;
 };
 
 struct LoopClosureConfig {

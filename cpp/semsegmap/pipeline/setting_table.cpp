@@ -201,6 +201,60 @@ std::vector<Setting> localizationSettings() {
   };
 }
 
+// Relocalization (localize/relocalizer.h) and its registration check.
+std::vector<Setting> relocalizationSettings() {
+  return {
+      flag(SEMSEGMAP_AT(localization.relocalization.enabled), kNotRecorded,
+           "search the whole map when the robot has not been localized for a while"),
+      number(SEMSEGMAP_AT(localization.relocalization.after_m), kNotRecorded,
+             "metres driven without a localization before relocalizing"),
+      count(SEMSEGMAP_AT(localization.relocalization.k), 1, 4096, kNotRecorded,
+            "nearest map descriptors per local segment that vote for places"),
+      count(SEMSEGMAP_AT(localization.relocalization.k_in_place), 1, 4096, kNotRecorded,
+            "of those, each local segment's nearest in a place that are verified"),
+      number(SEMSEGMAP_AT(localization.relocalization.place_radius_m), kNotRecorded,
+             "a place: the map segments this near its centre"),
+      number(SEMSEGMAP_AT(localization.relocalization.cell_m), kNotRecorded,
+             "spacing of the places' centres"),
+      count(SEMSEGMAP_AT(localization.relocalization.max_places), 1, 1000, kNotRecorded,
+            "places verified, best voted first"),
+      count(SEMSEGMAP_AT(localization.relocalization.min_votes), 1, 100000, kNotRecorded,
+            "local segments that must vote for a place to verify it"),
+      number(SEMSEGMAP_AT(localization.relocalization.verification.resolution_m), kNotRecorded,
+             "pairwise consistency tolerance within a place"),
+      count(SEMSEGMAP_AT(localization.relocalization.verification.min_inliers), 3, 1000,
+            kNotRecorded, "consistent correspondences a place needs"),
+      flag(SEMSEGMAP_AT(localization.relocalization.verification.refine), kNotRecorded,
+           "refit the transform on the final inliers"),
+      number(SEMSEGMAP_AT(localization.relocalization.verification.inlier_tolerance_m),
+             kNotRecorded, "an inlier lies within this of its target"),
+      number(SEMSEGMAP_AT(localization.relocalization.verification.min_spread_m), kNotRecorded,
+             "inliers spread less than this across their main axis are refused"),
+      count(SEMSEGMAP_AT(localization.relocalization.verification.max_search_nodes), 1, 1000000000,
+            kNotRecorded, "branch-and-bound nodes before the search settles"),
+      count(SEMSEGMAP_AT(localization.relocalization.check.max_points_per_segment), 1, 1000000,
+            kNotRecorded, "local points a segment contributes to the check"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.coarse_distance_m), kNotRecorded,
+             "correspondence distance of the check's coarse pass"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.fine_distance_m), kNotRecorded,
+             "correspondence distance of the check's fine pass"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.kernel_scale_m), kNotRecorded,
+             "Geman-McClure scale of the check's registration"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.near_m), kNotRecorded,
+             "a local point with a map point this near is an inlier"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.min_fitness), kNotRecorded,
+             "share of local points that must lie on the map's"),
+      count(SEMSEGMAP_AT(localization.relocalization.check.min_points), 1, kMaxPoints, kNotRecorded,
+            "fewer local or map points: refused"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.max_correction_m), kNotRecorded,
+             "registration may move the proposed pose this far"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.max_correction_deg), kNotRecorded,
+             "and turn it this much"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.place_radius_m), kNotRecorded,
+             "map points this near the robot are registered to"),
+  };
+}
+
 std::vector<Setting> mapAndLoopSettings() {
   return {
       number(SEMSEGMAP_AT(target_map.duplicate_distance_m), kNotRecorded,
@@ -307,8 +361,8 @@ std::vector<Setting> semanticsSettings() {
 
 std::vector<Setting> allSettings() {
   std::vector<Setting> all;
-  for (auto part : {frontEndSettings, localizationSettings, mapAndLoopSettings, odometrySettings,
-                    semanticsSettings}) {
+  for (auto part : {frontEndSettings, localizationSettings, relocalizationSettings,
+                    mapAndLoopSettings, odometrySettings, semanticsSettings}) {
     std::vector<Setting> settings = part();
     std::move(settings.begin(), settings.end(), std::back_inserter(all));
   }

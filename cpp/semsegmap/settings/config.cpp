@@ -232,6 +232,26 @@ YAML::Node loadConfigRoot(const std::filesystem::path& path) {
 
 namespace {
 
+void checkRelocalizationSettings(const std::filesystem::path& path, const RelocalizationConfig& c) {
+  auto check = [&](bool ok, const std::string& what) {
+    if (!ok) throw std::runtime_error(path.string() + ": localization.relocalization." + what);
+  };
+  check(c.after_m >= 0, "after_m: must not be negative");
+  check(c.place_radius_m > 0 && c.cell_m > 0, "place_radius_m, cell_m: must be positive");
+  check(c.cell_m <= c.place_radius_m, "cell_m: must not exceed place_radius_m");
+  check(c.verification.resolution_m > 0 && c.verification.inlier_tolerance_m > 0,
+        "verification: resolution_m and inlier_tolerance_m must be positive");
+  check(c.verification.min_spread_m >= 0, "verification.min_spread_m: must not be negative");
+  const RegistrationCheckConfig& r = c.check;
+  check(r.fine_distance_m > 0 && r.coarse_distance_m >= r.fine_distance_m,
+        "check: need 0 < fine_distance_m <= coarse_distance_m");
+  check(r.kernel_scale_m > 0 && r.near_m > 0 && r.place_radius_m > 0,
+        "check: kernel_scale_m, near_m and place_radius_m must be positive");
+  check(r.min_fitness >= 0 && r.min_fitness <= 1, "check.min_fitness: must be in [0, 1]");
+  check(r.max_correction_m > 0 && r.max_correction_deg > 0,
+        "check: max_correction_m and max_correction_deg must be positive");
+}
+
 // The cross-field checks and the limits a number has beyond being finite, of the sections read.
 void checkPipelineSettings(const std::filesystem::path& path, const Settings& c) {
   const auto& lm = c.local_map;
@@ -275,6 +295,7 @@ void checkPipelineSettings(const std::filesystem::path& path, const Settings& c)
         "localization.latest_scan_fallback_m: must not be negative");
   check(c.loop_closure.exclude_recent_m >= 0,
         "loop_closure.exclude_recent_m: must not be negative");
+  checkRelocalizationSettings(path, loc.relocalization);
 }
 
 void checkOdometrySettings(const std::filesystem::path& path, const OdometryConfig& c) {

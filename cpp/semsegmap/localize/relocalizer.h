@@ -1,0 +1,85 @@
+// Global relocalization from one scan: a robot that wakes up, is carried, or whose scans lie far
+// apart must find itself in the map from the few partial segments one scan cuts. The frame-to-
+// frame path (k nearest descriptors, a clique of at least min_inliers consistent centroids over
+// the whole map) then finds too few matches: a partial segment's descriptor is far from its
+// complete map segment's, so the right target is seldom among the 16 nearest, and three or four
+// right matches are lost among the whole map's chance cliques.
+//
+// Relocalization narrows the search instead of the evidence:
+//   1. place votes: every local segment's k_wide nearest map segments vote for the map places
+//      around them; a place's score is how many local segments have a candidate there;
+//   2. in each of the best places only each local segment's k_in_place nearest candidates there
+//      are verified, so a smaller clique (min_inliers) stands out;
+//   3. a pose is accepted only when the local points register to the map's stored points
+//      (localize/registration_check.h): the check that keeps a small clique from being wrong.
+// A prior (the last pose, a GNSS fix, a pose a user gives) restricts the places to those near it.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "semsegmap/localize/localizer.h"
+#include "semsegmap/localize/registration_check.h"
+
+namespace semsegmap {
+
+// A clique of four centroids, consistent within 1.5 m: one scan sees parts of the map's
+// segments, whose centroids lie metres from the whole segments' (a facade seen from one end), so
+// the frame-to-frame tolerance (0.4 m) leaves three or four consistent matches of a dozen right
+// ones, and one scan's partial segments seldom give six. The registration check, not the
+// clique, keeps a relocalization from being wrong, and gives the precise pose.
+inline GeometricVerificationConfig relocalizationVerification() {
+  GeometricVerificationConfig c;
+  c.min_inliers = 4;
+  c.resolution_m = 3.0;
+  c.inlier_tolerance_m = 6.0;
+  return c;
+}
+
+struct RelocalizationConfig {
+  // Off by default: it needs a target map with segment points (target_map.
+  // max_points_per_segment). On, a frame that the local map's segments do not localize goes this
+  // way when the robot has not been localized within the last `after_m` metres of driving (or
+  // ever): a robot just woken up, or one whose scans lie far apart.
+  bool enabled = false;
+  double after_m = 10.0;
+  int k = 64;  // nearest map descriptors per local segment that vote
+  // Within a place, each local segment's nearest candidates there: the place has removed the
+  // look-alikes elsewhere in the map, so the right target is again among the first few.
+  int k_in_place = 8;
+  double place_radius_m = 60.0;  // a place: the map segments this near its centre
+  double cell_m = 10.0;          // places are centred on a grid of this spacing (x, y)
+  size_t max_places = 10;        // places verified, best voted first
+  size_t min_votes = 4;          // a place fewer local segments voted for is not verified
+  GeometricVerificationConfig verification = relocalizationVerification();
+  RegistrationCheckConfig check;
+};
+
+// Where the robot may be, when something else says so.
+struct RelocalizationPrior {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // map frame
+  double radius_m = 50.0;                              // the robot is within this of it
+};
+
+struct Relocalization {
+  Localization match;  // T_map_local registered by the check
+  RegistrationCheck check;
+  size_t places_verified = 0;
+  double votes = 0;  // of the place that localized (weighted, relocalizer.cpp)
+};
+
+// `centroids`, `descriptors` and `segment_points` describe the local segments (local map frame);
+// `robot_local` is the robot's position in that frame. The localizer's map must hold segment
+// points. Nothing when no place passes both checks, or when two places far apart both do (the
+// scan fits both: no pose is safer than a wrong one).
+std::optional<Relocalization> relocalize(
+    const Localizer& localizer, const std::vector<Eigen::Vector3f>& centroids,
+    const Eigen::MatrixXf& descriptors,
+    const std::vector<std::vector<Eigen::Vector3f>>& segment_points,
+    const Eigen::Vector3d& robot_local, const RelocalizationConfig& config,
+    const std::optional<RelocalizationPrior>& prior = std::nullopt);
+
+}  // namespace semsegmap
