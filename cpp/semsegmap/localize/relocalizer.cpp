@@ -53,13 +53,15 @@ class PlaceGrid {
   // The best voted cells, each at least `apart_m` from the better ones taken, within the prior.
   std::vector<Place> best(size_t n, double min_votes, double apart_m,
                           const std::optional<RelocalizationPrior>& prior) const {
-    std::vector<size_t> order(votes_.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    // Only the cells with enough votes are sorted: a few hundred of a grid of up to 4e6.
+    std::vector<size_t> order;
+    for (size_t i = 0; i < votes_.size(); ++i)
+      if (votes_[i] >= min_votes) order.push_back(i);
     std::stable_sort(order.begin(), order.end(),
                      [&](size_t a, size_t b) { return votes_[a] > votes_[b]; });
     std::vector<Place> out;
     for (size_t i : order) {
-      if (out.size() >= n || votes_[i] < min_votes) break;
+      if (out.size() >= n) break;
       const Place p{centre(static_cast<int>(i / static_cast<size_t>(ny_)),
                            static_cast<int>(i % static_cast<size_t>(ny_))),
                     votes_[i]};
