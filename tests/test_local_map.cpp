@@ -222,6 +222,31 @@ TEST(GroundRemoval, FollowsATiltedGroundWithoutAFixedHeight) {
   EXPECT_GT(slope * 15.0, 2.0);
 }
 
+// Asked only for the points no camera saw, it answers for them as it would for the whole scan:
+// the classified points still give their cells' lowest returns.
+TEST(GroundRemoval, OnlyUnobservedPointsAreAskedAndAnsweredAsInTheWholeScan) {
+  EnrichedCloud scan;
+  for (float x = -10; x <= 10; x += 0.25f)
+    for (float y = -5; y <= 5; y += 0.25f) {
+      // The road a camera saw at x < 0; beyond it the points have no class.
+      scan.push_back(x < 0 ? point(x, y, 0.0f, cls::kRoad) : unobserved(x, y, 0.0f));
+      if (std::fmod(x + 10.0f, 2.0f) == 0.0f) scan.push_back(unobserved(x, y, 1.5f));
+    }
+  const auto all = markGround(scan, Pose::Identity(), GroundRemovalConfig{});
+  const auto asked = markGround(scan, Pose::Identity(), GroundRemovalConfig{}, true);
+  size_t unobserved_ground = 0;
+  for (size_t k = 0; k < scan.size(); ++k) {
+    if (scan[k].has_class) {
+      EXPECT_EQ(asked[k], 0) << k;
+      EXPECT_EQ(all[k], 1) << k;
+    } else {
+      EXPECT_EQ(asked[k], all[k]) << k;
+      unobserved_ground += asked[k];
+    }
+  }
+  EXPECT_GT(unobserved_ground, 1000u);
+}
+
 // A point no camera saw is not of class unknown: it keeps its geometry, votes for no class, and
 // its voxel takes the class of the frames in which a camera sees it (the front camera of a car
 // sees a place before the LiDAR sweeps past it from the side).

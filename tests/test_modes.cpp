@@ -276,6 +276,16 @@ TEST(Modes, AWakeUpIsRelocalizedFromOneScanAndThePathIsRecorded) {
   EXPECT_LT(r.translation_error_m, 0.3);
   EXPECT_LT(r.rotation_error_deg, 1.0);
 
+  // The one-scan call gives the same pose, whatever the config says, and leaves the run alone.
+  config.localization.relocalization.enabled = false;
+  const LocalizationSession session(config, run->info(), map, describer);
+  const std::optional<LocalizationRecord> one = session.relocalize(wake_up.frame(0));
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->path, LocalizationPath::kRelocalization);
+  EXPECT_TRUE(one->T_map_base.isApprox(r.T_map_base, 1e-9));
+  EXPECT_TRUE(session.run().localizations.empty());
+  config.localization.relocalization.enabled = true;
+
   const RelocalizationPrior elsewhere{r.T_map_base.translation() + Eigen::Vector3d(300, 0, 0),
                                       50.0};
   EXPECT_TRUE(

@@ -1,7 +1,7 @@
 # Type stubs of the bindings (python/src/), written by hand: python/tests/test_stubs.py checks
 # that they name exactly what the module has.
 from os import PathLike
-from typing import Dict, Iterator, List, Optional, Union
+from typing import Dict, Iterator, List, Optional, Sequence, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -636,6 +636,13 @@ class LocalizationSession:
                  describer: Describer, allow_config_mismatch: bool = False,
                  stages: Optional[FrontEndStages] = None) -> None: ...
     def process(self, frame: Frame) -> Optional[LocalizationRecord]: ...
+    @overload
+    def relocalize(self, frame: Frame, *,
+                   prior: Optional[Sequence[float]] = None) -> Optional[LocalizationRecord]: ...
+    @overload
+    def relocalize(self, points: _ArrayLike, images: Optional[List[_ArrayLike]] = None, *,
+                   label_images: Optional[List[Optional[_ArrayLike]]] = None,
+                   prior: Optional[Sequence[float]] = None) -> Optional[LocalizationRecord]: ...
     @property
     def run(self) -> LocalizationRun: ...
 

@@ -79,6 +79,8 @@ void setImages(Frame& f, const py::object& images, int channels, const char* wha
   }
 }
 
+}  // namespace
+
 Frame frameFrom(const FloatIn& points, const py::object& point_labels,
                 const py::object& point_times, const py::object& images,
                 const py::object& label_images, const py::object& T_odom_base,
@@ -101,6 +103,8 @@ Frame frameFrom(const FloatIn& points, const py::object& point_labels,
         poseFrom(T_world_base.cast<py::array_t<double, py::array::forcecast>>(), "T_world_base");
   return f;
 }
+
+namespace {
 
 // An image as a view: (H, W, 3) colour or (H, W) labels; None when the camera has none.
 py::object imageView(const Image& image, py::handle owner) {

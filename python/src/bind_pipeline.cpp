@@ -444,6 +444,28 @@ void bindLocalizationResults(py::module_& m) {
         py::arg("records"));
 }
 
+// (x, y) or (x, y, radius_m), as localize --prior X,Y[,RADIUS].
+std::optional<RelocalizationPrior> priorFrom(const py::object& prior) {
+  if (prior.is_none()) return std::nullopt;
+  const auto v = prior.cast<std::vector<double>>();
+  if ((v.size() != 2 && v.size() != 3) || (v.size() == 3 && !(v[2] > 0)))
+    throw py::value_error("prior: expected (x, y) or (x, y, radius_m) with radius_m > 0");
+  RelocalizationPrior p;
+  p.position = Eigen::Vector3d(v[0], v[1], 0.0);
+  if (v.size() == 3) p.radius_m = v[2];
+  return p;
+}
+
+py::object relocalizeOne(const LocalizationSession& s, const Frame& f, const py::object& prior) {
+  const std::optional<RelocalizationPrior> p = priorFrom(prior);
+  std::optional<LocalizationRecord> r;
+  {
+    py::gil_scoped_release release;
+    r = s.relocalize(f, p);
+  }
+  return r ? py::cast(std::move(*r)) : py::none();
+}
+
 void bindLocalization(py::module_& m) {
   bindLocalizationResults(m);
   py::class_<LocalizationSession>(m, "LocalizationSession",
@@ -475,6 +497,30 @@ void bindLocalization(py::module_& m) {
             return py::cast(s.run().localizations.back());
           },
           py::arg("frame"), "The LocalizationRecord this frame gave, or None")
+      .def(
+          "relocalize",
+          [](const LocalizationSession& s, const Frame& f, const py::object& prior) {
+            return relocalizeOne(s, f, prior);
+          },
+          py::arg("frame"), py::kw_only(), py::arg("prior") = py::none(),
+          "One scan on its own, as a robot that wakes up has it (the command line's first frame "
+          "with localize --relocalize, whatever the config's localization.relocalization "
+          "says); the session's run is untouched. prior: (x, y) or (x, y, radius_m) in the "
+          "map frame, radius 50 m. The LocalizationRecord (its T_map_base is the pose), or "
+          "None")
+      .def(
+          "relocalize",
+          [](const LocalizationSession& s,
+             const py::array_t<float, py::array::c_style | py::array::forcecast>& points,
+             const py::object& images, const py::object& label_images, const py::object& prior) {
+            const Frame f = frameFrom(points, py::none(), py::none(), images, label_images,
+                                      py::none(), py::none(), 0, 0.0);
+            return relocalizeOne(s, f, prior);
+          },
+          py::arg("points"), py::arg("images") = py::none(), py::kw_only(),
+          py::arg("label_images") = py::none(), py::arg("prior") = py::none(),
+          "The same for a scan given as arrays, as Frame(points, images=..., "
+          "label_images=...) takes them: the pose of the LiDAR's base in the map")
       .def_property_readonly(
           "run", [](const LocalizationSession& s) { return LocalizationRun(s.run()); },
           "the run so far (a copy)");

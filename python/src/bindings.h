@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "semsegmap/core/enriched_point.h"
+#include "semsegmap/core/frame.h"
 #include "semsegmap/core/pose.h"
 #include "semsegmap/core/sensor_rig.h"
 
@@ -134,5 +135,11 @@ EnrichedCloud enrichedCloudFrom(const py::array& a, const std::string& what);
 py::array_t<float> pointsArray(const std::vector<Eigen::Vector3f>& points);
 std::vector<Eigen::Vector3f> pointsFrom(const py::array_t<float, py::array::forcecast>& a,
                                         const std::string& what);
+// A frame from numpy arrays (copied), as Frame(points, ...) takes them.
+Frame frameFrom(const py::array_t<float, py::array::c_style | py::array::forcecast>& points,
+                const py::object& point_labels, const py::object& point_times,
+                const py::object& images, const py::object& label_images,
+                const py::object& T_odom_base, const py::object& T_world_base, size_t index,
+                double timestamp_s);
 
 }  // namespace semsegmap::python

@@ -101,3 +101,44 @@ def test_a_revisit_range_localized_frame_by_frame(config, describer, runs):
     assert all(395 <= r.frame_index <= 425 for r in records)
     assert max(r.translation_error_m for r in records) < 5.0  # none wrong
     assert [r.frame_index for r in session.run.localizations] == [r.frame_index for r in records]
+
+
+def test_one_scan_is_relocalized_by_the_command_line_and_python_alike(binary, tmp_path):
+    """localize --relocalize on a run's first scan, and LocalizationSession.relocalize on the
+    same scan, as a Frame and as arrays. The whole-map query is made to fail (min_inliers 1000)
+    so that the pose comes from the relocalization path."""
+    text = open(CONFIG).read()
+    assert "      min_inliers: 6" in text
+    config_path = str(tmp_path / "strict.yaml")
+    with open(config_path, "w") as f:
+        f.write(text.replace("      min_inliers: 6", "      min_inliers: 1000", 1))
+    dense = str(tmp_path / "dense.map")
+    finish_cli(start_cli(binary, "map", "--dataset", TINY_S1, "--config", config_path,
+                         "--max-frames", str(FRAMES), "--points", "512", "--out", dense))
+    out = str(tmp_path / "loc")
+    finish_cli(start_cli(binary, "localize", "--dataset", TINY_S2, "--map", dense, "--config",
+                         config_path, "--max-frames", "1", "--relocalize", "--out", out))
+    with open(os.path.join(out, "localizations.csv")) as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 1 and rows[0]["path"] == "relocalization", rows
+
+    config = ssm.load_config(config_path)
+    assert not config.localization.relocalization.enabled  # the call relocalizes regardless
+    ds = ssm.open_dataset(TINY_S2)
+    session = ssm.LocalizationSession(config, ds.info, ssm.load_map(dense),
+                                      ssm.describer_for(config.descriptor, ds.info))
+    frame = ds[0]
+    record = session.relocalize(frame)
+    assert record is not None and record.path == "relocalization"
+    np.testing.assert_allclose([float(rows[0][k]) for k in "xyz"], record.T_map_base[:3, 3],
+                               atol=2e-4)
+    assert record.registration_fitness == pytest.approx(float(rows[0]["fitness"]), abs=1e-3)
+    assert session.run.localizations == []
+    # The scan as arrays: its own frame is the local map's (no odometry), the same place.
+    arrays = session.relocalize(frame.points, frame.images, label_images=frame.label_images)
+    assert arrays is not None
+    assert np.linalg.norm(arrays.T_map_base[:3, 3] - record.T_map_base[:3, 3]) < 0.1
+    far = record.T_map_base[:2, 3] + 500.0
+    assert session.relocalize(frame, prior=(far[0], far[1], 50.0)) is None
+    with pytest.raises(ValueError, match="prior: expected"):
+        session.relocalize(frame, prior=(1.0,))

@@ -16,8 +16,11 @@ struct GroundRemovalConfig {
   double height_above_m = 0.25;  // points this close above the local ground are ground
 };
 
-// Marks ground points of a scan (1 = ground) given its pose in the map frame (z up).
+// Marks ground points of a scan (1 = ground) given its pose in the map frame (z up). With
+// `only_unobserved`, the points with a class are left 0 unasked: every point still gives its
+// cell's lowest return, but only the cells of points no camera saw fit a plane, which is most of
+// the work when the cameras see most of the scan.
 std::vector<uint8_t> markGround(const EnrichedCloud& scan, const Pose& T_map_lidar,
-                                const GroundRemovalConfig& config);
+                                const GroundRemovalConfig& config, bool only_unobserved = false);
 
 }  // namespace semsegmap

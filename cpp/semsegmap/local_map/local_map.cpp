@@ -85,7 +85,9 @@ LocalMapUpdate LocalMap::update(const EnrichedCloud& scan, const Pose& T_map_lid
   for (const EnrichedPoint& q : scan) classified += q.has_class;
   out.points_unobserved = scan.size() - classified;
   const bool geometric = config_.geometric_ground_removal || out.points_unobserved > 0;
-  if (geometric) ground_mask_ = markGround(scan, T_map_lidar, config_.ground);
+  // Only the points without a class are asked, unless the ground goes by geometry everywhere.
+  if (geometric)
+    ground_mask_ = markGround(scan, T_map_lidar, config_.ground, !config_.geometric_ground_removal);
   const bool drop_unobserved = config_.remove_unobserved && classified > 0;
   const Eigen::Matrix3f R = T_map_lidar.linear().cast<float>();
   const Eigen::Vector3f t = T_map_lidar.translation().cast<float>();

@@ -77,15 +77,20 @@ std::optional<Localization> Localizer::localize(const std::vector<Eigen::Vector3
   }
   const VerificationResult v = verify(candidates, config_.verification);
   if (!v.found) return std::nullopt;
-  Localization out;
-  out.T_map_local = v.T_target_local;
-  out.inliers = static_cast<int>(v.inliers.size());
-  out.candidates = candidates.size();
+  return localizationOf(v, candidates);
+}
+
+Localization localizationOf(const VerificationResult& v,
+                            const std::vector<Correspondence>& candidates) {
+  Localization l;
+  l.T_map_local = v.T_target_local;
+  l.inliers = static_cast<int>(v.inliers.size());
+  l.candidates = candidates.size();
   for (int i : v.inliers) {
     const Correspondence& c = candidates[static_cast<size_t>(i)];
-    out.matches.emplace_back(static_cast<size_t>(c.local_id), static_cast<size_t>(c.target_id));
+    l.matches.emplace_back(static_cast<size_t>(c.local_id), static_cast<size_t>(c.target_id));
   }
-  return out;
+  return l;
 }
 
 }  // namespace semsegmap

@@ -30,6 +30,10 @@ struct Localization {
   std::vector<std::pair<size_t, size_t>> matches;
 };
 
+// The localization a verification found among `candidates`: its pose and matched pairs.
+Localization localizationOf(const VerificationResult& v,
+                            const std::vector<Correspondence>& candidates);
+
 // Owns or shares its target map: a saved map is shared between localizers (it never changes),
 // a map that grows while the robot moves (loop closure) is the localizer's own, copied on the
 // first change if it was shared. Growing adds to the descriptor index instead of rebuilding it.

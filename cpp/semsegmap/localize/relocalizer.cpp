@@ -110,17 +110,11 @@ std::vector<Correspondence> candidatesIn(const Neighbours& nn, const TargetMap& 
   return out;
 }
 
-Localization localizationOf(const VerificationResult& v,
-                            const std::vector<Correspondence>& candidates) {
-  Localization l;
-  l.T_map_local = v.T_target_local;
-  l.inliers = static_cast<int>(v.inliers.size());
-  l.candidates = candidates.size();
-  for (int i : v.inliers) {
-    const Correspondence& c = candidates[static_cast<size_t>(i)];
-    l.matches.emplace_back(static_cast<size_t>(c.local_id), static_cast<size_t>(c.target_id));
-  }
-  return l;
+// The robot within the check's own tolerance in both: registration would take one to the other.
+bool samePose(const Pose& a, const Pose& b, const Eigen::Vector3d& robot_local,
+              const RegistrationCheckConfig& check) {
+  return (a * robot_local - b * robot_local).norm() <= check.max_correction_m &&
+         rotationErrorDeg(a, b) <= check.max_correction_deg;
 }
 
 }  // namespace
@@ -147,6 +141,7 @@ std::optional<Relocalization> relocalize(
       grid.vote(static_cast<int>(q), map.segments[static_cast<size_t>(nn.id(q, j))].centroid,
                 config.place_radius_m, 1.0 / (1.0 + static_cast<double>(j) / config.k_in_place));
   std::vector<Relocalization> accepted;
+  std::vector<Pose> checked;
   size_t verified = 0;
   // min_votes local segments, each voting with a candidate at k_in_place down its list (weight
   // 1/2), at the least.
@@ -159,6 +154,13 @@ std::optional<Relocalization> relocalize(
     if (!v.found) continue;
     Relocalization r;
     r.match = localizationOf(v, candidates);
+    // Places closer than two radii share segments, and a weaker neighbour of a place often
+    // verifies to the same pose: its check would repeat one already made.
+    if (std::any_of(checked.begin(), checked.end(), [&](const Pose& T) {
+          return samePose(T, r.match.T_map_local, robot_local, config.check);
+        }))
+      continue;
+    checked.push_back(r.match.T_map_local);
     r.check =
         checkRegistration(segment_points, robot_local, map, r.match.T_map_local, config.check);
     r.votes = place.votes;

@@ -203,6 +203,7 @@ LocalizationSession::LocalizationSession(const PipelineConfig& config, const Dat
     : config_(config),
       info_(infoWithStages(info, stages)),
       describer_(describer),
+      stages_(stages),
       localizer_(checkedMap(std::move(map), requireDescriber(describer, "LocalizationSession"),
                             config, settings),
                  config.localization.localizer),
@@ -223,11 +224,14 @@ void LocalizationSession::process(const Frame& frame) {
   const size_t every = std::max<size_t>(1, config_.localization.every_n_frames);
   if (frames_++ % every == 0) {
     const auto t0 = std::chrono::steady_clock::now();
-    const Outcome o = localizeFrame(frame, r.T_local_base, moved);
+    const RelocalizationConfig& reloc = config_.localization.relocalization;
+    const bool lost = localized_at_m_ < 0 || run_.distance_m - localized_at_m_ >= reloc.after_m;
+    const Outcome o =
+        localizeFrame(pipeline_, frame, r.T_local_base, moved, reloc.enabled && lost, prior_);
     r.times.localize_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (o.attempt.found) {
-      record(frame, o.T_map_base, o.attempt, o.path);
+      run_.localizations.push_back(recordOf(frame, o));
       localized_at_m_ = run_.distance_m;
     }
   }
@@ -238,27 +242,25 @@ void LocalizationSession::process(const Frame& frame) {
 // The local map's segments first; then, when the scan lies far from the one before, its own
 // segments (localization.latest_scan_fallback_m); then, when the robot has not been localized
 // for a while, those of the last try against the whole map (localization.relocalization).
-LocalizationSession::Outcome LocalizationSession::localizeFrame(const Frame& frame,
-                                                                const Pose& T_local_base,
-                                                                double moved) const {
+LocalizationSession::Outcome LocalizationSession::localizeFrame(
+    const Pipeline& pipeline, const Frame& frame, const Pose& T_local_base, double moved,
+    bool relocalize, const std::optional<RelocalizationPrior>& prior) const {
   Outcome o;
-  o.attempt = attempt(pipeline_);
-  const Pipeline* tried = &pipeline_;
+  o.attempt = attempt(pipeline);
+  const Pipeline* tried = &pipeline;
   Pose base = T_local_base;
   std::optional<Pipeline> scan;
   const double fallback_m = config_.localization.latest_scan_fallback_m;
   if (!o.attempt.found && fallback_m > 0 && moved >= fallback_m) {
     scan.emplace(config_, info_, PoseSource::kOdometry, describer_);
     // The scan as the front-end stages left it: labelled and posed.
-    base = scan->process(pipeline_.processedFrame(frame)).T_local_base;
+    base = scan->process(pipeline.processedFrame(frame)).T_local_base;
     o.attempt = attempt(*scan);
     o.path = LocalizationPath::kLatestScan;
     tried = &*scan;
   }
-  const RelocalizationConfig& reloc = config_.localization.relocalization;
-  if (!o.attempt.found && reloc.enabled &&
-      (localized_at_m_ < 0 || run_.distance_m - localized_at_m_ >= reloc.after_m)) {
-    o.attempt = attemptRelocalization(*tried, base);
+  if (!o.attempt.found && relocalize) {
+    o.attempt = attemptRelocalization(*tried, base, prior);
     o.path = LocalizationPath::kRelocalization;
   }
   if (o.attempt.found) o.T_map_base = o.attempt.found->T_map_local * base;
@@ -277,14 +279,15 @@ LocalizationSession::Attempt LocalizationSession::attempt(const Pipeline& pipeli
 }
 
 LocalizationSession::Attempt LocalizationSession::attemptRelocalization(
-    const Pipeline& pipeline, const Pose& T_local_base) const {
+    const Pipeline& pipeline, const Pose& T_local_base,
+    const std::optional<RelocalizationPrior>& prior) const {
   Attempt a;
   a.query = pipeline.localSegmentQuery();
   std::vector<std::vector<Eigen::Vector3f>> points(a.query.ids.size());
   for (size_t i = 0; i < points.size(); ++i) points[i] = pipeline.observedPoints(a.query.ids[i]);
   const std::optional<Relocalization> r =
-      relocalize(localizer_, a.query.centroids, a.query.descriptors, points,
-                 T_local_base.translation(), config_.localization.relocalization, prior_);
+      semsegmap::relocalize(localizer_, a.query.centroids, a.query.descriptors, points,
+                            T_local_base.translation(), config_.localization.relocalization, prior);
   if (r) {
     a.found = r->match;
     a.fitness = r->check.fitness;
@@ -305,18 +308,35 @@ Refinement LocalizationSession::refine(const Pipeline& pipeline, const Localizat
   return refinePose(l, local_points, localizer_.map(), config_.localization.refinement);
 }
 
-void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, const Attempt& a,
-                                 LocalizationPath path) {
+std::optional<LocalizationRecord> LocalizationSession::relocalize(
+    const Frame& frame, const std::optional<RelocalizationPrior>& prior) const {
+  if (!hasSegmentPoints(localizer_.map()))
+    throw std::invalid_argument(
+        "relocalize: the target map stores no segment points, which a relocalization needs to "
+        "check a pose: build it with target_map.max_points_per_segment (map --points N)");
+  // No odometry: one scan's local map is in the scan's own frame (the frame's T_odom_base).
+  DatasetInfo info = info_;
+  info.has_odometry = true;
+  Pipeline scan(config_, info, PoseSource::kOdometry, describer_,
+                FrontEndStages{stages_.network, std::nullopt});
+  const Pose T_local_base = scan.process(frame).T_local_base;
+  const Outcome o = localizeFrame(scan, frame, T_local_base, 0.0, true, prior);
+  if (!o.attempt.found) return std::nullopt;
+  return recordOf(frame, o);
+}
+
+LocalizationRecord LocalizationSession::recordOf(const Frame& frame, const Outcome& o) const {
+  const Attempt& a = o.attempt;
   const Localization& l = *a.found;
   LocalizationRecord rec;
   rec.frame_index = frame.index;
   const FrameStamp stamp = stampOf(frame, info_);
   rec.frame_number = stamp.number;
   rec.timestamp_s = stamp.time_s;
-  rec.T_map_base = T_map_base;
+  rec.T_map_base = o.T_map_base;
   rec.inliers = l.inliers;
   rec.candidates = l.candidates;
-  rec.path = path;
+  rec.path = o.path;
   rec.registration_fitness = a.fitness;
   if (frame.T_world_base) {
     rec.T_world_base = *frame.T_world_base;
@@ -331,7 +351,7 @@ void LocalizationSession::record(const Frame& frame, const Pose& T_map_base, con
     rec.matches.emplace_back(
         (l.T_map_local * a.query.centroids.at(query).cast<double>()).cast<float>(),
         localizer_.map().segments.at(target).centroid);
-  run_.localizations.push_back(std::move(rec));
+  return rec;
 }
 
 const char* localizationPathName(LocalizationPath path) {

@@ -146,6 +146,12 @@ class LocalizationSession {
   void setPrior(std::optional<RelocalizationPrior> prior) { prior_ = std::move(prior); }
   const LocalizationRun& run() const { return run_; }
   LocalizationRun take() { return std::move(run_); }
+  // One scan on its own, as a robot that wakes up has it: the frame through a fresh front end
+  // (the network, no odometry: the scan's frame is its local map's) and the first frame's path of
+  // `process` with relocalization on, whatever the config says; the map must store points. The
+  // session's run and state are untouched. `prior` as setPrior's. The record, or nothing found.
+  std::optional<LocalizationRecord> relocalize(
+      const Frame& frame, const std::optional<RelocalizationPrior>& prior = std::nullopt) const;
 
  private:
   // One localization attempt on a pipeline's local segments.
@@ -156,19 +162,24 @@ class LocalizationSession {
     LocalSegmentQuery query;
   };
   Attempt attempt(const Pipeline& pipeline) const;
-  Attempt attemptRelocalization(const Pipeline& pipeline, const Pose& T_local_base) const;
+  Attempt attemptRelocalization(const Pipeline& pipeline, const Pose& T_local_base,
+                                const std::optional<RelocalizationPrior>& prior) const;
   struct Outcome {
     Attempt attempt;
     LocalizationPath path = LocalizationPath::kLocalMap;
     Pose T_map_base = Pose::Identity();
   };
-  Outcome localizeFrame(const Frame& frame, const Pose& T_local_base, double moved) const;
+  // `relocalize`: try the relocalization path when the other paths find nothing.
+  Outcome localizeFrame(const Pipeline& pipeline, const Frame& frame, const Pose& T_local_base,
+                        double moved, bool relocalize,
+                        const std::optional<RelocalizationPrior>& prior) const;
   Refinement refine(const Pipeline& pipeline, const Localization& l,
                     const LocalSegmentQuery& q) const;
-  void record(const Frame& frame, const Pose& T_map_base, const Attempt& a, LocalizationPath path);
+  LocalizationRecord recordOf(const Frame& frame, const Outcome& o) const;
   PipelineConfig config_;
   DatasetInfo info_;
   std::shared_ptr<Describer> describer_;
+  FrontEndStages stages_;
   Localizer localizer_;
   Pipeline pipeline_;
   LocalizationRun run_;
