@@ -1,5 +1,6 @@
 #include "semsegmap/localize/registration_check.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -30,15 +31,23 @@ std::vector<Eigen::Vector3d> mapPointsNear(const TargetMap& map, const Eigen::Ve
   return out;
 }
 
-// Share of `source` points (already in the map frame) with a map point within near_m. Distance
+// About n of `points`, evenly spaced.
+std::vector<Eigen::Vector3d> about(const std::vector<Eigen::Vector3d>& points, size_t n) {
+  const size_t step = std::max<size_t>(1, points.size() / n);
+  std::vector<Eigen::Vector3d> out;
+  for (size_t i = 0; i < points.size(); i += step) out.push_back(points[i]);
+  return out;
+}
+
+// Share of `points` with a map point within distance_m at `T`, the fitness at near_m. Distance
 // to the nearest point rather than to a voxel's plane: a voxel at a building's corner or where
 // two segments meet fits a plane through neither, and counted a third of the points of the
 // right pose of a town of small buildings as off.
-double fitnessOf(const std::vector<Eigen::Vector3d>& source, const VoxelMap& map,
-                 const RegistrationCheckConfig& config) {
-  size_t inliers = 0;
-  for (const Eigen::Vector3d& p : source) inliers += map.closest(p, config.near_m).found;
-  return source.empty() ? 0.0 : static_cast<double>(inliers) / static_cast<double>(source.size());
+double overlap(const std::vector<Eigen::Vector3d>& points, const VoxelMap& map, const Pose& T,
+               double distance_m) {
+  size_t near = 0;
+  for (const Eigen::Vector3d& p : points) near += map.closest(T * p, distance_m).found;
+  return points.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(points.size());
 }
 
 }  // namespace
@@ -62,24 +71,38 @@ RegistrationCheck checkRegistration(const std::vector<std::vector<Eigen::Vector3
   c /= static_cast<double>(local.size());
   for (Eigen::Vector3d& p : local) p -= c;
   const Pose proposed = T_map_local * Eigen::Translation3d(c);
-  // Voxels as large as the coarse distance, so that the 3 x 3 x 3 searched hold every point
-  // within it and each holds enough of the map's sparse stored points for a plane.
-  VoxelMap reference(config.coarse_distance_m, 256);
-  reference.add(target, target);
+  // Voxels as large as each pass's distance, so that the 3 x 3 x 3 searched hold every point
+  // within it. The coarse pass keeps 32 points a voxel: a real scan's segments put hundreds in a
+  // 3 m voxel, and searching them all was most of a relocalization; its planes still come from
+  // every point. The fine pass and the fitness search 1 m voxels, whose points are all kept.
+  VoxelMap coarse(config.coarse_distance_m, 32);
+  coarse.add(target, target);
+  VoxelMap fine(std::max(1.0, std::max(config.fine_distance_m, config.near_m)), 64);
+  fine.add(target, target);
+  // Most proposed places of a relocalization are wrong. On about 1600 points (800 lost one of
+  // the simulator's HDL-64E wake-ups), a wrong one is refused when it has not half the fitness
+  // asked for, at the coarse distance before the coarse pass, then at near_m after it: only a
+  // likely place pays for the fine pass on every point.
+  const std::vector<Eigen::Vector3d> few = about(local, 1600);
+  const char* apart = "the points do not overlap the map";
+  if (overlap(few, coarse, proposed, config.coarse_distance_m) < config.min_fitness / 2)
+    return refused(T_map_local, apart);
   IcpConfig icp;
-  icp.min_correspondences = config.min_points;
+  icp.min_correspondences = std::min(config.min_points, few.size());
   IcpResult r =
-      alignToMap(local, reference, proposed, config.coarse_distance_m, config.kernel_scale_m, icp);
-  if (r.enough_correspondences)
-    r = alignToMap(local, reference, r.T, config.fine_distance_m, config.kernel_scale_m, icp);
-  if (!r.enough_correspondences) return refused(T_map_local, "the points do not overlap the map");
+      alignToMap(few, coarse, proposed, config.coarse_distance_m, config.kernel_scale_m, icp);
+  if (!r.enough_correspondences) return refused(T_map_local, apart);
+  if (overlap(few, fine, r.T, config.near_m) < config.min_fitness / 2)
+    return refused(r.T * Eigen::Translation3d(-c), "the points do not lie on the map's");
+  icp.min_correspondences = config.min_points;
+  r = alignToMap(local, fine, r.T, config.fine_distance_m, config.kernel_scale_m, icp);
+  if (!r.enough_correspondences) return refused(T_map_local, apart);
   RegistrationCheck out;
   out.T_map_local = r.T * Eigen::Translation3d(-c);
   out.points = local.size();
   out.correction_m = translationError(r.T, proposed);
   out.correction_deg = rotationErrorDeg(r.T, proposed);
-  for (Eigen::Vector3d& p : local) p = r.T * p;
-  out.fitness = fitnessOf(local, reference, config);
+  out.fitness = overlap(local, fine, r.T, config.near_m);
   if (out.correction_m > config.max_correction_m || out.correction_deg > config.max_correction_deg)
     out.reason = "registration moved the pose too far";
   else if (out.fitness < config.min_fitness)
