@@ -396,19 +396,27 @@ WAKE_UP_BY = (1, 2, 3, 5, 10)
 
 
 def wake_ups_table(inputs):
-    header = ([("config", 0), ("method", 0), ("wake-ups at a revisit", 1)] +
-              [(f"by frame {k}", 1) for k in WAKE_UP_BY] + [("first localization wrong", 1),
-                                                            ("ms / query", 1)])
+    """One revisits.json, or RIG=FILE for each of several (a column names the rig)."""
+    runs = labelled(inputs) if any("=" in i for i in inputs) else [(None, i) for i in inputs]
+    rig = [("rig", 0)] if runs[0][0] is not None else []
+    loaded = [(label, path, load_revisits(path)) for label, path in runs]
+    # Up to the frames a wake-up was given: a one-scan wake-up has no second frame.
+    frames = max(e.get("wake_up_frames") or WAKE_UP_BY[-1] for _, _, e in loaded)
+    by_frame = [k for k in WAKE_UP_BY if k <= frames]
+    header = (rig + [("config", 0), ("method", 0), ("wake-ups at a revisit", 1)] +
+              [(f"by frame {k}", 1) for k in by_frame] + [("first localization wrong", 1),
+                                                          ("ms / query", 1)])
     rows = []
-    for path in inputs:
-        for r in load_revisits(path)["results"]:
+    for label, path, e in loaded:
+        for r in e["results"]:
             at_revisit = [w for w in r["wake_ups"] if w["revisit"]]
             if not r["wake_ups"]:
                 fail(f"{path}: no wake-ups (run eval revisits with --wake-up N[/EVERY])")
             by = [sum(1 for w in at_revisit if w["localized_at_frame"] is not None
-                      and w["localized_at_frame"] <= k) for k in WAKE_UP_BY]
+                      and w["localized_at_frame"] <= k) for k in by_frame]
             wrong = sum(1 for w in r["wake_ups"] if w["wrong_first"])
-            rows.append([r["config"], revisit_method(r), len(at_revisit), *by, wrong,
+            rows.append(([label] if rig else []) +
+                        [r["config"], revisit_method(r), len(at_revisit), *by, wrong,
                          ms_per_query(r)])
     return table(header, rows)
 

@@ -182,6 +182,17 @@ def test_revisit_tables_say_which_method_gave_each_row_and_its_time(tmp_path):
     assert rows[0].startswith("| config | method | wake-ups at a revisit | by frame 1 |"), rows[0]
     assert rows[4] == ("| scan-context | Scan Context (whole scan) | 2 | 0 | 1 | 1 | 1 | 1 | 1 "
                        "| 180.0 |")
+    # One file per rig, each labelled: a first column names the rig.
+    rows = write_table(tmp_path, "wake-ups", [f"paper={path}", f"HDL-64E={path}"])
+    assert rows[0].startswith("| rig | config | method | wake-ups at a revisit |"), rows[0]
+    assert rows[2].startswith("| paper | semsegmap | segments (semsegmap-net) | 2 |"), rows[2]
+    assert rows[7].startswith("| HDL-64E | scan-context |"), rows[7]
+    # One-scan wake-ups: no column for frames they were not given.
+    path.write_text(json.dumps({"n_revisits": 4, "wake_up_frames": 1, "results": [
+        revisit_result("semsegmap", "segments", "semsegmap-net", wake_ups, 41.25)]}))
+    rows = write_table(tmp_path, "wake-ups", [str(path)])
+    assert "| by frame 1 | first localization wrong |" in rows[0], rows[0]
+    assert rows[2] == "| semsegmap | segments (semsegmap-net) | 2 | 0 | 1 | 41.2 |", rows[2]
 
 
 def documented_writes():
