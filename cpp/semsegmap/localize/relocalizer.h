@@ -6,8 +6,9 @@
 // right matches are lost among the whole map's chance cliques.
 //
 // Relocalization narrows the search instead of the evidence:
-//   1. place votes: every local segment's k_wide nearest map segments vote for the map places
-//      around them; a place's score is how many local segments have a candidate there;
+//   1. place votes: every local segment's k nearest map segments vote for the map places around
+//      them, each local segment once per place with its best-ranked candidate there, weighted
+//      down by that rank (relocalizer.cpp);
 //   2. in each of the best places only each local segment's k_in_place nearest candidates there
 //      are verified, so a smaller clique (min_inliers) stands out;
 //   3. a pose is accepted only when the local points register to the map's stored points
@@ -26,7 +27,7 @@
 
 namespace semsegmap {
 
-// A clique of four centroids, consistent within 1.5 m: one scan sees parts of the map's
+// A clique of four centroids, consistent within 3 m: one scan sees parts of the map's
 // segments, whose centroids lie metres from the whole segments' (a facade seen from one end), so
 // the frame-to-frame tolerance (0.4 m) leaves three or four consistent matches of a dozen right
 // ones, and one scan's partial segments seldom give six. The registration check, not the
