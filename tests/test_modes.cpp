@@ -302,6 +302,44 @@ TEST(Modes, AWakeUpIsRelocalizedFromOneScanAndThePathIsRecorded) {
   EXPECT_ONE_LINE(error);
 }
 
+// localization.relocalization.scan_context: a map with segment points and
+// target_map.scan_context_apart_m keeps the scan context of a scan every metre (one without
+// points keeps none); a wake-up's own scan context proposes its place even
+// where no place has the votes to be verified, and the registration check gives the pose.
+TEST(Modes, AWakeUpIsRelocalizedFromItsScanContextWhereNoPlaceIsVotedFor) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  PipelineConfig config = semsegmapConfig();
+  config.target_map.scan_context_apart_m = 1.0;
+  const auto describer = std::make_shared<OracleDescriber>();
+  auto mapped = openDataset("sim:world=1,run=S1,preset=tiny,frames=80");
+  FrameSubset few(*mapped, {0, 1, 2});
+  EXPECT_EQ(runMapping(few, config, PoseSource::kGroundTruth, describer).map.scan_contexts.size(),
+            0u);
+  config.target_map.max_points_per_segment = 512;
+  const auto map = std::make_shared<const TargetMap>(
+      runMapping(*mapped, config, PoseSource::kGroundTruth, describer).map);
+  const auto& scans = map->scan_contexts.scans();
+  ASSERT_GE(scans.size(), 20u);
+  for (size_t i = 1; i < scans.size(); ++i)
+    EXPECT_GE(
+        (scans[i].T_world_scan.translation() - scans[i - 1].T_world_scan.translation()).norm(),
+        config.target_map.scan_context_apart_m);
+
+  auto run = openDataset("sim:world=1,run=S2,preset=tiny,frames=80");
+  FrameSubset wake_up(*run, {15});
+  config.localization.localizer.verification.min_inliers = 1000;
+  config.localization.relocalization.enabled = true;
+  config.localization.relocalization.min_votes = 100000;  // no place is verified
+  const LocalizationRun with = runLocalization(wake_up, config, map, describer);
+  ASSERT_EQ(with.localizations.size(), 1u);
+  const LocalizationRecord& r = with.localizations[0];
+  EXPECT_EQ(r.path, LocalizationPath::kScanContext);
+  EXPECT_LT(r.translation_error_m, 0.3);
+  EXPECT_LT(r.rotation_error_deg, 1.0);
+  config.localization.relocalization.scan_context = false;
+  EXPECT_TRUE(runLocalization(wake_up, config, map, describer).localizations.empty());
+}
+
 // Segments leave the local map finished (their views go into the map), absorbed (their views go
 // to the survivor) or dropped as too large and then gone: the session holds views only of
 // segments still in the local map, so a long run's memory stays that of its local map.

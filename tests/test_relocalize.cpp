@@ -143,6 +143,68 @@ TEST(Relocalizer, APriorRestrictsThePlaces) {
                           RelocalizationConfig{}, far));
 }
 
+// A map holding one scan context; a scan whose bins are its columns turned by `shift` sectors
+// (so the two lie `shift` sectors apart in yaw).
+struct TurnedScan {
+  TargetMap map;
+  ScanContextQuery scan;
+  Pose T_map_mapped =
+      Eigen::Translation3d(100, 50, 0) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
+};
+TurnedScan turnedScan(int shift) {
+  SeededRng rng(3);
+  Eigen::MatrixXf bins(20, 60);
+  for (Eigen::Index k = 0; k < bins.size(); ++k)
+    bins(k) = rng.uniform(0, 1) < 0.3 ? 0.0f : static_cast<float>(rng.uniform(0.5, 12));
+  TurnedScan t;
+  t.map.scan_contexts.add(scanContextOfBins(bins), t.T_map_mapped);
+  Eigen::MatrixXf turned(20, 60);
+  for (Eigen::Index j = 0; j < 60; ++j) turned.col(j) = bins.col((j + shift) % 60);
+  t.scan.context = scanContextOfBins(turned);
+  t.scan.T_local_scan =
+      Eigen::Translation3d(1, 2, 0) * Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ());
+  return t;
+}
+
+// The map's scan context corroborates a pose that puts the scan near the mapped one at the yaw
+// their columns say, and no other: turned 30 degrees more, or 20 m away.
+TEST(Relocalizer, TheMapsScanContextsCorroborateOnlyAPoseThatAgreesWithThem) {
+  const TurnedScan t = turnedScan(10);  // 60 degrees
+  const RelocalizationConfig config;
+  auto poseOf = [&](double yaw_deg, double ahead_m) {
+    const Pose T_map_scan = t.T_map_mapped *
+                            Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()) *
+                            Eigen::Translation3d(ahead_m, 0, 0);
+    return Pose(T_map_scan * t.scan.T_local_scan.inverse());
+  };
+  EXPECT_TRUE(scanContextAgrees(t.map, t.scan, poseOf(60, 2), config));
+  EXPECT_TRUE(scanContextAgrees(t.map, t.scan, poseOf(66, 2), config)) << "a sector off";
+  EXPECT_FALSE(scanContextAgrees(t.map, t.scan, poseOf(90, 2), config));
+  EXPECT_FALSE(scanContextAgrees(t.map, t.scan, poseOf(60, 20), config));
+
+  // corroborate() lets such a pose pass with scan_context_min_fitness, not less, and only with the
+  // scan's scan context.
+  RegistrationCheck c;
+  c.T_map_local = poseOf(60, 2);
+  c.points = 1000;
+  c.fitness = 0.5;
+  c.reason = "the points do not lie on the map's";
+  RegistrationCheck without = c;
+  corroborate(without, t.map, std::nullopt, config);
+  EXPECT_FALSE(without.accepted);
+  RegistrationCheck low = c;
+  low.fitness = config.scan_context_min_fitness - 0.05;
+  corroborate(low, t.map, t.scan, config);
+  EXPECT_FALSE(low.accepted);
+  RegistrationCheck far = c;
+  far.T_map_local = poseOf(90, 2);
+  corroborate(far, t.map, t.scan, config);
+  EXPECT_FALSE(far.accepted);
+  corroborate(c, t.map, t.scan, config);
+  EXPECT_TRUE(c.accepted);
+  EXPECT_TRUE(c.reason.empty());
+}
+
 TEST(Relocalizer, RefusesMismatchedInput) {
   const Town town = makeTown(20, 200, 9);
   const Localizer localizer(town.map, wholeMapLocalizer());

@@ -196,6 +196,37 @@ TEST(ScanContextDatabase, FindsTheMappedScanNearTheQueryInABoxWorld) {
   EXPECT_LE(std::abs(wrappedDeg(m->distance.yaw_rad / kDeg - 150)), kSectorDeg);
 }
 
+// nearest(): the n mapped scans nearest by scan context, nearest first, the first of them best()'s;
+// a scan context rebuilt from its bins (a map file's) compares as the original.
+TEST(ScanContextDatabase, NearestListsTheClosestFirstAndBinsRebuildTheScanContext) {
+  const std::vector<Eigen::Vector3d> world = boxWorld(4);
+  ScanContextDatabase db;
+  for (double x = 0; x <= 100; x += 5)
+    db.add(makeScanContext(scanAt(world, lidarAt(x, 0, 0)), {}), lidarAt(x, 0, 0));
+  const ScanContext query = makeScanContext(scanAt(world, lidarAt(60.8, 0.4, 150)), {});
+  const std::vector<ScanContextMatch> near = db.nearest(query, db.size(), 3);
+  ASSERT_EQ(near.size(), 3u);
+  EXPECT_EQ(near[0].index, db.best(query)->index);
+  EXPECT_LE(near[0].distance.distance, near[1].distance.distance);
+  EXPECT_LE(near[1].distance.distance, near[2].distance.distance);
+  EXPECT_EQ(db.nearest(query, 1, 5).size(), 1u) << "only the ring keys' nearest is compared";
+  const ScanContext rebuilt = scanContextOfBins(query.bins);
+  EXPECT_EQ(rebuilt.ring_key, query.ring_key);
+  EXPECT_EQ(rebuilt.occupied, query.occupied);
+  EXPECT_EQ(scanContextDistance(rebuilt, db.scans()[12].context).distance,
+            scanContextDistance(query, db.scans()[12].context).distance);
+}
+
+// The scan context's frame: the LiDAR's position, the base's orientation.
+TEST(ScanContext, ItsFrameIsTheLidarPositionTurnedAsTheBase) {
+  const Pose T_world_base = lidarAt(3, 4, 30);
+  const Pose T_base_lidar =
+      Eigen::Translation3d(0.5, 0, 1.7) * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX());
+  const Pose T = scanContextFrame(T_world_base, T_base_lidar);
+  EXPECT_TRUE(T.linear().isApprox(T_world_base.linear()));
+  EXPECT_TRUE(T.translation().isApprox((T_world_base * T_base_lidar).translation()));
+}
+
 // On the simulator: S1 of the tiny world drives the street of its first 60 frames again from
 // frame 395 on. Each query frame there that passes within 2 m of a mapped frame finds a mapped
 // scan within a few metres of it, turned by the right yaw.

@@ -84,6 +84,52 @@ TEST(MapFile, RoundTripIsExactUpToFloat16) {
   EXPECT_EQ(loadTargetMap(path).descriptors, map.descriptors);
 }
 
+void resign(std::string& bytes) {
+  const uint64_t sum = fnv1a64(bytes.data(), bytes.size() - 8, kProjectFnvSeed);
+  std::memcpy(&bytes[bytes.size() - 8], &sum, sizeof(sum));
+}
+
+// A map's scan contexts (target_map.scan_context_apart_m) come back with their frames and their
+// bins to float16, compare as they did, and a corrupt grid or pose is refused naming the file.
+TEST(MapFile, ScanContextsRoundTripAndACorruptOneIsRefused) {
+  TargetMap map = randomMap(20, 16, true);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> height(0.0f, 12.0f);
+  for (int i = 0; i < 3; ++i) {
+    Eigen::MatrixXf bins(20, 60);
+    for (Eigen::Index k = 0; k < bins.size(); ++k) bins(k) = k % 3 == 0 ? 0.0f : height(rng);
+    const Pose T = Eigen::Translation3d(1000.0 + i, -2.5 * i, 0.3) *
+                   Eigen::AngleAxisd(0.4 * i, Eigen::Vector3d::UnitZ());
+    map.scan_contexts.add(scanContextOfBins(bins), T);
+  }
+  const auto path = tempPath("scan_contexts.map");
+  saveTargetMap(path, map);
+  const TargetMap back = loadTargetMap(path);
+  ASSERT_EQ(back.scan_contexts.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    const auto& a = map.scan_contexts.scans()[i];
+    const auto& b = back.scan_contexts.scans()[i];
+    EXPECT_LT((a.T_world_scan.translation() - b.T_world_scan.translation()).norm(), 1e-9);
+    EXPECT_LT(rotationErrorDeg(a.T_world_scan, b.T_world_scan), 1e-3);
+    EXPECT_LT((a.context.bins - b.context.bins).cwiseAbs().maxCoeff(), 0.01f);
+    EXPECT_EQ(a.context.ring_key, b.context.ring_key);
+    EXPECT_NEAR(scanContextDistance(b.context, a.context).distance, 0.0, 1e-6);
+  }
+  // The first scan's first rotation value (the quaternion's w), made 2: not a rotation.
+  std::string bytes = readFileBytes(path);
+  const size_t grid = bytes.size() - 8 - 3 * (24 + 16 + 2 * 20 * 60) - 8 - 12;
+  float w = 0.0f;
+  std::memcpy(&w, &bytes[grid + 12 + 8 + 24], sizeof(w));
+  ASSERT_NEAR(w, 1.0f, 1e-6f) << "the layout docs/map-format.md gives";
+  w = 2.0f;
+  std::memcpy(&bytes[grid + 12 + 8 + 24], &w, sizeof(w));
+  resign(bytes);
+  writeBytesAtomically(path, bytes);
+  const std::string error = expectLoadError(path);
+  EXPECT_NE(error.find(path.string() + ": scan context 0: not a pose"), std::string::npos) << error;
+  EXPECT_EQ(randomMap(20, 16, false).scan_contexts.size(), 0u);
+}
+
 TEST(MapFile, SizeIsAtMost150BytesASegmentWith64dDescriptors) {
   const TargetMap map = randomMap(10000, 64, false);
   const auto path = tempPath("size.map");
@@ -134,10 +180,6 @@ TEST(MapFile, AnotherFormatVersionIsRejectedWithItsNumber) {
 }
 
 // Re-signs `bytes` after a patch, so that only the patched value is wrong.
-void resign(std::string& bytes) {
-  const uint64_t sum = fnv1a64(bytes.data(), bytes.size() - 8, kProjectFnvSeed);
-  std::memcpy(&bytes[bytes.size() - 8], &sum, sizeof(sum));
-}
 
 TEST(MapFile, Version1IsRefusedAskingToRebuild) {
   const auto path = tempPath("version1.map");

@@ -255,6 +255,10 @@ class RelocalizationConfig:
     min_votes: int
     verification: GeometricVerificationConfig
     check: RegistrationCheckConfig
+    scan_context: bool
+    scan_context_max_distance: float
+    scan_context_candidates: int
+    scan_context_min_fitness: float
     def __init__(self, **fields: object) -> None: ...
 
 class LocalizationConfig:
@@ -271,6 +275,7 @@ class TargetMapBuilderConfig:
     duplicate_distance_m: float
     max_points_per_segment: int
     earlier_observations_apart_m: float
+    scan_context_apart_m: float
     def __init__(self, **fields: object) -> None: ...
 
 class PoseGraphConfig:

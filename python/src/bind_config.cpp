@@ -106,7 +106,11 @@ void bindLocalizationConfigs(py::module_& m) {
       .field("max_places", &RL::max_places)
       .field("min_votes", &RL::min_votes)
       .field("verification", &RL::verification)
-      .field("check", &RL::check);
+      .field("check", &RL::check)
+      .field("scan_context", &RL::scan_context)
+      .field("scan_context_max_distance", &RL::scan_context_max_distance)
+      .field("scan_context_candidates", &RL::scan_context_candidates)
+      .field("scan_context_min_fitness", &RL::scan_context_min_fitness);
   StructBinding<LocalizationConfig>(m, "LocalizationConfig", "pipeline/pipeline_config.h")
       .field("localizer", &LocalizationConfig::localizer)
       .field("every_n_frames", &LocalizationConfig::every_n_frames)
@@ -117,7 +121,8 @@ void bindLocalizationConfigs(py::module_& m) {
   StructBinding<TMB>(m, "TargetMapBuilderConfig", "localize/target_map.h")
       .field("duplicate_distance_m", &TMB::duplicate_distance_m)
       .field("max_points_per_segment", &TMB::max_points_per_segment)
-      .field("earlier_observations_apart_m", &TMB::earlier_observations_apart_m);
+      .field("earlier_observations_apart_m", &TMB::earlier_observations_apart_m)
+      .field("scan_context_apart_m", &TMB::scan_context_apart_m);
   StructBinding<PoseGraphConfig>(m, "PoseGraphConfig", "graph/pose_graph.h")
       .field("odometry_translation_sigma_m", &PoseGraphConfig::odometry_translation_sigma_m)
       .field("odometry_rotation_sigma_rad", &PoseGraphConfig::odometry_rotation_sigma_rad)

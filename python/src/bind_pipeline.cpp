@@ -397,10 +397,13 @@ void bindLocalizationRecord(py::module_& m) {
       .def_readonly("refinement_correction_m", &LocalizationRecord::refinement_correction_m)
       .def_property_readonly(
           "path", [](const LocalizationRecord& r) { return localizationPathName(r.path); },
-          "which segments localized: 'local-map', 'latest-scan' (latest_scan_fallback_m) or "
-          "'relocalization' (localization.relocalization)")
-      .def_readonly("registration_fitness", &LocalizationRecord::registration_fitness,
-                    "a relocalization's share of local points on the map's; None otherwise");
+          "which segments localized: 'local-map', 'latest-scan' (latest_scan_fallback_m), "
+          "'relocalization' (localization.relocalization) or 'scan-context' (a relocalization "
+          "from the pose the map's nearest scan context proposed)")
+      .def_readonly(
+          "registration_fitness", &LocalizationRecord::registration_fitness,
+          "the registration check's share of local points on the map's (a relocalization, or "
+          "any pose while lost); None otherwise");
 }
 
 void bindLocalizationResults(py::module_& m) {

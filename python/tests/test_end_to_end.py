@@ -144,3 +144,28 @@ def test_one_scan_is_relocalized_by_the_command_line_and_python_alike(binary, tm
     assert session.relocalize(frame, prior=(far[0], far[1], 50.0)) is None
     with pytest.raises(ValueError, match="prior: expected"):
         session.relocalize(frame, prior=(1.0,))
+
+
+def test_a_lost_robot_gives_no_pose_its_scan_does_not_register_to(describer):
+    """The whole-map query made loose (two inliers): a wake-up's first scan then matches the map
+    at wrong places. While the robot is lost, with relocalization on, a pose of any path must
+    pass the registration check, which refuses them."""
+    config = ssm.load_config(CONFIG)
+    config.target_map.max_points_per_segment = 512
+    built = ssm.run_mapping(ssm.open_dataset(TINY_S1), config, describer, max_frames=80)
+    config.localization.localizer.verification.min_inliers = 2
+    ds = ssm.open_dataset(TINY_S2)
+
+    def first_errors(relocalize):
+        config.localization.relocalization.enabled = relocalize
+        errors = []
+        for i in (14, 42, 49):
+            r = ssm.LocalizationSession(config, ds.info, built.map, describer).process(ds[i])
+            errors.append(None if r is None else r.translation_error_m)
+        return errors
+
+    off = first_errors(False)
+    assert sum(e is not None and e > 5 for e in off) >= 2, off
+    on = first_errors(True)
+    assert all(e is None or e < 1 for e in on), on
+    assert any(e is not None for e in on), on

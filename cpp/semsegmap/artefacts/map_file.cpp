@@ -1,10 +1,12 @@
 #include "semsegmap/artefacts/map_file.h"
 
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string_view>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/binary_io.h"
@@ -16,6 +18,9 @@ namespace {
 constexpr std::string_view kMagic("SSMMAP\r\n", 8);
 constexpr uint32_t kFlagFloat16 = 1u << 0;
 constexpr uint32_t kFlagPoints = 1u << 1;
+constexpr uint32_t kFlagScanContexts = 1u << 2;
+// A scan context grid finer than this is a corrupt header, refused before allocating it.
+constexpr uint16_t kMaxScanContextBins = 1024;
 // A map records a few dozen settings; more is a corrupt count, refused before reading on.
 constexpr uint16_t kMaxParameters = 1024;
 
@@ -72,6 +77,55 @@ std::string firstNonFinite(const TargetMap& map) {
   return {};
 }
 
+// The scan contexts (flag bit 2): the grid, then per scan its frame and its bins as float16.
+void putScanContexts(BinaryWriter& w, const ScanContextDatabase& db) {
+  const ScanContextConfig& c = db.config();
+  w.put<uint16_t>(static_cast<uint16_t>(c.rings));
+  w.put<uint16_t>(static_cast<uint16_t>(c.sectors));
+  w.put<float>(static_cast<float>(c.max_radius_m));
+  w.put<float>(static_cast<float>(c.height_offset_m));
+  w.put<uint64_t>(db.size());
+  for (const ScanContextDatabase::MappedScan& s : db.scans()) {
+    const Eigen::Vector3d t = s.T_world_scan.translation();
+    const Eigen::Quaterniond q(s.T_world_scan.linear());
+    for (int k = 0; k < 3; ++k) w.put<double>(t[k]);
+    for (double v : {q.w(), q.x(), q.y(), q.z()}) w.put<float>(static_cast<float>(v));
+    for (Eigen::Index i = 0; i < s.context.bins.size(); ++i) putHalf(w, s.context.bins(i));
+  }
+}
+
+ScanContextDatabase getScanContexts(BinaryReader& r) {
+  ScanContextConfig c;
+  c.rings = r.get<uint16_t>("the scan contexts");
+  c.sectors = r.get<uint16_t>("the scan contexts");
+  c.max_radius_m = r.get<float>("the scan contexts");
+  c.height_offset_m = r.get<float>("the scan contexts");
+  if (c.rings == 0 || c.sectors == 0 || c.rings > kMaxScanContextBins ||
+      c.sectors > kMaxScanContextBins || !(c.max_radius_m > 0) || !std::isfinite(c.max_radius_m) ||
+      !std::isfinite(c.height_offset_m))
+    r.fail("implausible scan context grid " + std::to_string(c.rings) + " x " +
+           std::to_string(c.sectors));
+  const size_t bins = c.rings * c.sectors;
+  const uint64_t n = r.getCount(24 + 16 + 2 * bins, "the scan contexts");
+  ScanContextDatabase db(c);
+  for (uint64_t i = 0; i < n; ++i) {
+    Pose T = Pose::Identity();
+    for (int k = 0; k < 3; ++k) T.translation()[k] = r.get<double>("a scan context");
+    double q[4];
+    for (double& v : q) v = r.get<float>("a scan context");
+    const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+    if (!T.translation().allFinite() || !(std::abs(rotation.norm() - 1.0) < 1e-3))
+      r.fail("scan context " + std::to_string(i) + ": not a pose");
+    T.linear() = rotation.normalized().toRotationMatrix();
+    Eigen::MatrixXf b(c.rings, c.sectors);
+    for (Eigen::Index k = 0; k < b.size(); ++k) b(k) = getHalf(r, "a scan context");
+    if (!b.allFinite() || (b.array() < 0).any())
+      r.fail("scan context " + std::to_string(i) + ": a non-finite or negative bin");
+    db.add(scanContextOfBins(std::move(b)), T);
+  }
+  return db;
+}
+
 }  // namespace
 
 uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
@@ -88,7 +142,9 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
   BinaryWriter w;
   w.putBytes(kMagic.data(), kMagic.size());
   w.put<uint32_t>(kMapFormatVersion);
-  w.put<uint32_t>((options.float16 ? kFlagFloat16 : 0u) | (points ? kFlagPoints : 0u));
+  const bool scan_contexts = map.scan_contexts.size() > 0;
+  w.put<uint32_t>((options.float16 ? kFlagFloat16 : 0u) | (points ? kFlagPoints : 0u) |
+                  (scan_contexts ? kFlagScanContexts : 0u));
   w.putString8(map.descriptor);
   w.putString8(map.fingerprint);
   w.put<uint32_t>(static_cast<uint32_t>(map.dimension()));
@@ -115,6 +171,7 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
       for (const Eigen::Vector3f& p : s.points)
         for (int k = 0; k < 3; ++k) putHalf(w, p[k] - s.centroid[k]);
     }
+  if (scan_contexts) putScanContexts(w, map.scan_contexts);
   w.putChecksum();
   writeBytesAtomically(path, w.bytes());
   return w.bytes().size();
@@ -133,7 +190,7 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
            std::to_string(kMapFormatVersion) + " (rebuild the map with `semsegmap map`)");
   r.checksummed();
   const uint32_t flags = r.get<uint32_t>("the header");
-  if (flags & ~(kFlagFloat16 | kFlagPoints))
+  if (flags & ~(kFlagFloat16 | kFlagPoints | kFlagScanContexts))
     r.fail("unknown header flags " + std::to_string(flags));
   TargetMap map;
   map.descriptor = r.getString8("the header");
@@ -162,6 +219,7 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
       for (Eigen::Vector3f& p : s.points)
         for (int k = 0; k < 3; ++k) p[k] = s.centroid[k] + getHalf(r, "the points");
     }
+  if (flags & kFlagScanContexts) map.scan_contexts = getScanContexts(r);
   r.expectEnd("the segments");
   if (const std::string bad = firstNonFinite(map); !bad.empty()) r.fail(bad);
   map.source = path.string();

@@ -117,20 +117,58 @@ bool samePose(const Pose& a, const Pose& b, const Eigen::Vector3d& robot_local,
          rotationErrorDeg(a, b) <= check.max_correction_deg;
 }
 
-}  // namespace
+// The proposals' registration checks: a proposal that puts the robot where an earlier one did is
+// not checked again (neighbouring places share segments, and a weaker one often verifies to the
+// same pose).
+class Checks {
+ public:
+  Checks(const std::vector<std::vector<Eigen::Vector3f>>& points,
+         const Eigen::Vector3d& robot_local, const TargetMap& map,
+         const RelocalizationConfig& relocalization, const std::optional<ScanContextQuery>& scan)
+      : points_(points),
+        robot_local_(robot_local),
+        map_(map),
+        relocalization_(relocalization),
+        config_(relocalization.check),
+        scan_(scan) {}
 
-std::optional<Relocalization> relocalize(
-    const Localizer& localizer, const std::vector<Eigen::Vector3f>& centroids,
-    const Eigen::MatrixXf& descriptors,
-    const std::vector<std::vector<Eigen::Vector3f>>& segment_points,
-    const Eigen::Vector3d& robot_local, const RelocalizationConfig& config,
-    const std::optional<RelocalizationPrior>& prior) {
-  if (static_cast<size_t>(descriptors.rows()) != centroids.size() ||
-      segment_points.size() != centroids.size())
-    throw std::invalid_argument("relocalize: one descriptor and point set per centroid expected");
+  // The scan context's pose is checked whatever was checked before, and is no reason to skip a
+  // place after it: a voted place's clique can start the registration metres off where the scan
+  // context's starts within one, and the other way round.
+  void check(Relocalization r) {
+    const Pose& T = r.match.T_map_local;
+    if (!r.by_scan_context) {
+      if (std::any_of(checked_.begin(), checked_.end(),
+                      [&](const Pose& c) { return samePose(c, T, robot_local_, config_); }))
+        return;
+      checked_.push_back(T);
+    }
+    r.check = checkRegistration(points_, robot_local_, map_, T, config_);
+    corroborate(r.check, map_, scan_, relocalization_);
+    if (!r.check.accepted) return;
+    r.match.T_map_local = r.check.T_map_local;
+    accepted.push_back(std::move(r));
+  }
+
+  std::vector<Relocalization> accepted;
+
+ private:
+  const std::vector<std::vector<Eigen::Vector3f>>& points_;
+  Eigen::Vector3d robot_local_;
+  const TargetMap& map_;
+  const RelocalizationConfig& relocalization_;
+  const RegistrationCheckConfig& config_;
+  const std::optional<ScanContextQuery>& scan_;
+  std::vector<Pose> checked_;
+};
+
+// Steps 1 and 2 (relocalizer.h): the places the local segments vote for, each verified with the
+// candidates in it. Returns the number of places verified.
+size_t checkVotedPlaces(const Localizer& localizer, const std::vector<Eigen::Vector3f>& centroids,
+                        const Eigen::MatrixXf& descriptors, const RelocalizationConfig& config,
+                        const std::optional<RelocalizationPrior>& prior, Checks& checks) {
   const TargetMap& map = localizer.map();
-  if (centroids.size() < static_cast<size_t>(config.verification.min_inliers) || map.size() == 0)
-    return std::nullopt;
+  if (centroids.size() < static_cast<size_t>(config.verification.min_inliers)) return 0;
   const int k = std::min<int>(config.k, static_cast<int>(map.size()));
   const Neighbours nn = localizer.index().search(descriptors, k);
   PlaceGrid grid(map, config.cell_m);
@@ -140,8 +178,6 @@ std::optional<Relocalization> relocalize(
     for (int j = 0; j < nn.k && nn.id(q, j) >= 0; ++j)
       grid.vote(static_cast<int>(q), map.segments[static_cast<size_t>(nn.id(q, j))].centroid,
                 config.place_radius_m, 1.0 / (1.0 + static_cast<double>(j) / config.k_in_place));
-  std::vector<Relocalization> accepted;
-  std::vector<Pose> checked;
   size_t verified = 0;
   // min_votes local segments, each voting with a candidate at k_in_place down its list (weight
   // 1/2), at the least.
@@ -154,20 +190,77 @@ std::optional<Relocalization> relocalize(
     if (!v.found) continue;
     Relocalization r;
     r.match = localizationOf(v, candidates);
-    // Places closer than two radii share segments, and a weaker neighbour of a place often
-    // verifies to the same pose: its check would repeat one already made.
-    if (std::any_of(checked.begin(), checked.end(), [&](const Pose& T) {
-          return samePose(T, r.match.T_map_local, robot_local, config.check);
-        }))
-      continue;
-    checked.push_back(r.match.T_map_local);
-    r.check =
-        checkRegistration(segment_points, robot_local, map, r.match.T_map_local, config.check);
     r.votes = place.votes;
-    if (!r.check.accepted) continue;
-    r.match.T_map_local = r.check.T_map_local;
-    accepted.push_back(std::move(r));
+    checks.check(std::move(r));
   }
+  return verified;
+}
+
+// The mapped scan whose scan context is nearest the scan's, turned by their yaw.
+void checkScanContext(const TargetMap& map, const ScanContextQuery& scan,
+                      const Eigen::Vector3d& robot_local, const RelocalizationConfig& config,
+                      const std::optional<RelocalizationPrior>& prior, Checks& checks) {
+  for (const ScanContextMatch& m :
+       map.scan_contexts.nearest(scan.context, config.scan_context_candidates, 1)) {
+    if (m.distance.distance >= config.scan_context_max_distance) continue;
+    Relocalization r;
+    r.match.T_map_local = m.T_world_query() * scan.T_local_scan.inverse();
+    r.by_scan_context = true;
+    if (prior &&
+        ((r.match.T_map_local * robot_local).head<2>() - prior->position.head<2>()).norm() >
+            prior->radius_m)
+      continue;
+    checks.check(std::move(r));
+  }
+}
+
+}  // namespace
+
+bool scanContextAgrees(const TargetMap& map, const ScanContextQuery& scan, const Pose& T_map_local,
+                       const RelocalizationConfig& config) {
+  constexpr double kNearM = 10.0;
+  const Pose T_map_scan = T_map_local * scan.T_local_scan;
+  const double sector = 2.0 * M_PI / static_cast<double>(map.scan_contexts.config().sectors);
+  for (const ScanContextDatabase::MappedScan& m : map.scan_contexts.scans()) {
+    if ((m.T_world_scan.translation() - T_map_scan.translation()).norm() > kNearM) continue;
+    const ScanContextDistance d = scanContextDistance(scan.context, m.context);
+    if (d.distance >= config.scan_context_max_distance) continue;
+    // The yaw the pose gives between the mapped scan's frame and the scan's, against theirs.
+    const double yaw = yawOf(m.T_world_scan.inverse() * T_map_scan);
+    if (std::abs(std::remainder(yaw - d.yaw_rad, 2.0 * M_PI)) <= 2.0 * sector) return true;
+  }
+  return false;
+}
+
+void corroborate(RegistrationCheck& check, const TargetMap& map,
+                 const std::optional<ScanContextQuery>& scan, const RelocalizationConfig& config) {
+  if (check.accepted || !scan || !config.scan_context || check.points == 0) return;
+  // Only a registration that ran to the end and kept to its bounds, short of the fitness.
+  if (check.fitness < config.scan_context_min_fitness ||
+      check.correction_m > config.check.max_correction_m ||
+      check.correction_deg > config.check.max_correction_deg)
+    return;
+  if (!scanContextAgrees(map, *scan, check.T_map_local, config)) return;
+  check.accepted = true;
+  check.reason.clear();
+}
+
+std::optional<Relocalization> relocalize(
+    const Localizer& localizer, const std::vector<Eigen::Vector3f>& centroids,
+    const Eigen::MatrixXf& descriptors,
+    const std::vector<std::vector<Eigen::Vector3f>>& segment_points,
+    const Eigen::Vector3d& robot_local, const RelocalizationConfig& config,
+    const std::optional<RelocalizationPrior>& prior, const std::optional<ScanContextQuery>& scan) {
+  if (static_cast<size_t>(descriptors.rows()) != centroids.size() ||
+      segment_points.size() != centroids.size())
+    throw std::invalid_argument("relocalize: one descriptor and point set per centroid expected");
+  const TargetMap& map = localizer.map();
+  if (map.size() == 0) return std::nullopt;
+  Checks checks(segment_points, robot_local, map, config, scan);
+  const size_t verified =
+      checkVotedPlaces(localizer, centroids, descriptors, config, prior, checks);
+  if (scan && config.scan_context) checkScanContext(map, *scan, robot_local, config, prior, checks);
+  const std::vector<Relocalization>& accepted = checks.accepted;
   if (accepted.empty()) return std::nullopt;
   // Two places that both fit, far apart: the scan cannot tell them apart.
   const Eigen::Vector3d first = accepted[0].match.T_map_local * robot_local;

@@ -13,6 +13,11 @@
 //      are verified, so a smaller clique (min_inliers) stands out;
 //   3. a pose is accepted only when the local points register to the map's stored points
 //      (localize/registration_check.h): the check that keeps a small clique from being wrong.
+// When the map holds scan contexts of its scans (target_map.scan_context_apart_m), the scan's own
+// scan context proposes a pose too: the mapped scan it is nearest, turned by their yaw. One
+// scan's segments are few and partial on a sparse LiDAR (a VLP-32 cuts a handful), where its
+// scan context, the whole scan's shape, still finds the place; the registration check decides
+// alike for both.
 // A prior (the last pose, a GNSS fix, a pose a user gives) restricts the places to those near it.
 #pragma once
 
@@ -57,6 +62,20 @@ struct RelocalizationConfig {
   size_t min_votes = 4;          // a place fewer local segments voted for is not verified
   GeometricVerificationConfig verification = relocalizationVerification();
   RegistrationCheckConfig check;
+  // The map's nearest scan context, when the map holds them, proposes a pose too when it is
+  // nearer than this (Scan Context's own threshold, scan_context.h: at 0.2 every place it
+  // accepted on S1 and on KITTI was right), of the scan contexts whose ring keys are the
+  // scan_context_candidates nearest.
+  bool scan_context = true;
+  double scan_context_max_distance = 0.2;
+  size_t scan_context_candidates = 10;
+  // A pose the check registered with a fitness below check.min_fitness but at least this is
+  // accepted when the map's scan contexts corroborate it (scanContextAgrees). Real scans see
+  // much the map's scans did not (KITTI: right poses had 0.57 of their points on the map's,
+  // wrong ones refused below 0.3), while the simulator's repeated buildings give wrong places up
+  // to 0.58: the points alone cannot tell them apart, the whole scan's shape can. One VLP-32
+  // scan's few segments had 0.34 and 0.42 at the right place, where Scan Context found it.
+  double scan_context_min_fitness = 0.3;
 };
 
 // Where the robot may be, when something else says so.
@@ -65,9 +84,30 @@ struct RelocalizationPrior {
   double radius_m = 50.0;                              // the robot is within this of it
 };
 
+// The scan's own scan context (made with the map's grid) and the frame it was made in, in the
+// local map's frame (scanContextFrame).
+struct ScanContextQuery {
+  ScanContext context;
+  Pose T_local_scan = Pose::Identity();
+};
+
+// Whether the map's scan contexts corroborate a pose: one of the mapped scans within 10 m of where
+// T_map_local puts the scan's frame is within scan_context_max_distance of the scan's, at a yaw
+// within two sectors of the pose's. Mapped scans lie a metre apart, and at 5 m or more from a
+// mapped scan a scan scores above the threshold anyway (scan_context.h).
+bool scanContextAgrees(const TargetMap& map, const ScanContextQuery& scan, const Pose& T_map_local,
+                       const RelocalizationConfig& config);
+
+// The registration check's verdict, widened to a fitness of scan_context_min_fitness that the
+// map's scan contexts corroborate (when `scan` is given and config.scan_context is on): sets
+// check.accepted and clears its reason then.
+void corroborate(RegistrationCheck& check, const TargetMap& map,
+                 const std::optional<ScanContextQuery>& scan, const RelocalizationConfig& config);
+
 struct Relocalization {
-  Localization match;  // T_map_local registered by the check
+  Localization match;  // T_map_local registered by the check; no matches from a scan context
   RegistrationCheck check;
+  bool by_scan_context = false;  // the pose the check started from was the scan context's
   size_t places_verified = 0;
   double votes = 0;  // of the place that localized (weighted, relocalizer.cpp)
 };
@@ -75,12 +115,14 @@ struct Relocalization {
 // `centroids`, `descriptors` and `segment_points` describe the local segments (local map frame);
 // `robot_local` is the robot's position in that frame. The localizer's map must hold segment
 // points. Nothing when no place passes both checks, or when two places far apart both do (the
-// scan fits both: no pose is safer than a wrong one).
+// scan fits both: no pose is safer than a wrong one). `scan` proposes a place too when the map
+// holds scan contexts and config.scan_context is on.
 std::optional<Relocalization> relocalize(
     const Localizer& localizer, const std::vector<Eigen::Vector3f>& centroids,
     const Eigen::MatrixXf& descriptors,
     const std::vector<std::vector<Eigen::Vector3f>>& segment_points,
     const Eigen::Vector3d& robot_local, const RelocalizationConfig& config,
-    const std::optional<RelocalizationPrior>& prior = std::nullopt);
+    const std::optional<RelocalizationPrior>& prior = std::nullopt,
+    const std::optional<ScanContextQuery>& scan = std::nullopt);
 
 }  // namespace semsegmap

@@ -70,11 +70,23 @@ ScanContext makeScanContext(const std::vector<LidarPoint>& points, const ScanCon
     float& bin = sc.bins(static_cast<Eigen::Index>(ring), static_cast<Eigen::Index>(sector));
     bin = std::max(bin, height);
   }
-  sc.ring_key = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(config.rings));
+  return scanContextOfBins(std::move(sc.bins));
+}
+
+Pose scanContextFrame(const Pose& T_world_base, const Pose& T_base_lidar) {
+  Pose T_base_scan = Pose::Identity();
+  T_base_scan.translation() = T_base_lidar.translation();
+  return T_world_base * T_base_scan;
+}
+
+ScanContext scanContextOfBins(Eigen::MatrixXf bins) {
+  ScanContext sc;
+  sc.bins = std::move(bins);
+  sc.ring_key = Eigen::VectorXf::Zero(sc.bins.rows());
   for (Eigen::Index r = 0; r < sc.bins.rows(); ++r) {
     const auto occupied = static_cast<size_t>((sc.bins.row(r).array() > 0).count());
     sc.occupied += occupied;
-    sc.ring_key(r) = static_cast<float>(occupied) / static_cast<float>(config.sectors);
+    sc.ring_key(r) = static_cast<float>(occupied) / static_cast<float>(sc.bins.cols());
   }
   return sc;
 }
@@ -120,22 +132,32 @@ uint64_t ScanContextDatabase::bytes() const {
   return bytes;
 }
 
-std::optional<ScanContextMatch> ScanContextDatabase::best(const ScanContext& query) const {
-  if (query.empty()) return std::nullopt;
+std::vector<ScanContextMatch> ScanContextDatabase::nearest(const ScanContext& query,
+                                                           size_t candidates, size_t n) const {
+  if (query.empty()) return {};
   std::vector<std::pair<float, size_t>> by_key;
   for (size_t i = 0; i < scans_.size(); ++i)
     if (!scans_[i].context.empty())
       by_key.emplace_back((scans_[i].context.ring_key - query.ring_key).squaredNorm(), i);
-  const size_t n = std::min(config_.candidates, by_key.size());
-  std::partial_sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(n), by_key.end());
-  std::optional<ScanContextMatch> found;
-  for (size_t k = 0; k < n; ++k) {
+  const size_t m = std::min(candidates, by_key.size());
+  std::partial_sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(m), by_key.end());
+  std::vector<ScanContextMatch> found;
+  for (size_t k = 0; k < m; ++k) {
     const MappedScan& scan = scans_[by_key[k].second];
-    const ScanContextDistance d = scanContextDistance(query, scan.context);
-    if (!found || d.distance < found->distance.distance)
-      found = ScanContextMatch{by_key[k].second, d, scan.T_world_scan};
+    found.push_back(
+        {by_key[k].second, scanContextDistance(query, scan.context), scan.T_world_scan});
   }
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
+    return a.distance.distance < b.distance.distance;
+  });
+  if (found.size() > n) found.resize(n);
   return found;
+}
+
+std::optional<ScanContextMatch> ScanContextDatabase::best(const ScanContext& query) const {
+  const std::vector<ScanContextMatch> found = nearest(query, config_.candidates, 1);
+  if (found.empty()) return std::nullopt;
+  return found[0];
 }
 
 std::optional<ScanContextMatch> ScanContextDatabase::query(const ScanContext& query) const {

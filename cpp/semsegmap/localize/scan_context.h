@@ -63,6 +63,12 @@ struct ScanContext {
 // scan context.
 ScanContext makeScanContext(const std::vector<LidarPoint>& points, const ScanContextConfig& config,
                             const Eigen::Matrix3d& R_level_sensor = Eigen::Matrix3d::Identity());
+// The frame a LiDAR's scan context is made in: the LiDAR's position on the base, turned as the
+// base is (z up), whatever the LiDAR's own mounting.
+Pose scanContextFrame(const Pose& T_world_base, const Pose& T_base_lidar);
+
+// A scan context of stored bins (a map file's): the ring key and occupancy follow from them.
+ScanContext scanContextOfBins(Eigen::MatrixXf bins);
 
 struct ScanContextDistance {
   double distance = 1.0;  // 1 - mean cosine similarity of the non-empty column pairs; 1: none
@@ -87,11 +93,19 @@ struct ScanContextMatch {
 // of millions of scans would put them into a DescriptorIndex (descriptor_index.h).
 class ScanContextDatabase {
  public:
-  explicit ScanContextDatabase(const ScanContextConfig& config = {});
+  // Not explicit without arguments: a map (TargetMap) holds one, and value-initializing a struct
+  // that holds a map ({}) copy-initializes it.
+  ScanContextDatabase() : ScanContextDatabase(ScanContextConfig{}) {}
+  explicit ScanContextDatabase(const ScanContextConfig& config);
+  struct MappedScan {
+    ScanContext context;
+    Pose T_world_scan;  // the levelled frame the scan context was made in
+  };
   // Returns the scan's index. An empty scan context is kept (indices follow the caller's scans)
   // but never matches.
   size_t add(ScanContext context, const Pose& T_world_scan);
   size_t size() const { return scans_.size(); }
+  const std::vector<MappedScan>& scans() const { return scans_; }
   uint64_t bytes() const;  // of the scan contexts and ring keys
   const ScanContextConfig& config() const { return config_; }
   // Of the `candidates` mapped scans whose ring keys are nearest the query's, the one whose scan
@@ -99,12 +113,12 @@ class ScanContextDatabase {
   std::optional<ScanContextMatch> best(const ScanContext& query) const;
   // best(), when its distance is below config().max_distance.
   std::optional<ScanContextMatch> query(const ScanContext& query) const;
+  // Of the `candidates` mapped scans whose ring keys are nearest the query's, the `n` nearest by
+  // scan context, nearest first, whatever their distance.
+  std::vector<ScanContextMatch> nearest(const ScanContext& query, size_t candidates,
+                                        size_t n) const;
 
  private:
-  struct MappedScan {
-    ScanContext context;
-    Pose T_world_scan;
-  };
   ScanContextConfig config_;
   std::vector<MappedScan> scans_;
 };

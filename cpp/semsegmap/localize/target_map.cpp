@@ -42,6 +42,7 @@ TargetMap TargetMapBuilder::build() const {
   map.descriptor = descriptor_;
   map.fingerprint = fingerprint_;
   map.parameters = parameters_;
+  map.scan_contexts = scans_;
   size_t n = 0;
   for (bool a : alive_) n += a;
   map.descriptors.resize(static_cast<Eigen::Index>(n), dimension_);

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "semsegmap/core/class_table.h"
+#include "semsegmap/localize/scan_context.h"
 
 namespace semsegmap {
 
@@ -34,6 +35,9 @@ struct TargetMap {
   std::vector<MapSegment> segments;
   Eigen::MatrixXf descriptors;  // one row per segment
   MapParameters parameters;     // what it was built with; empty for a map made by hand
+  // Scan contexts of the mapping run's scans (target_map.scan_context_apart_m), in the map frame:
+  // a relocalization checks the places they propose beside those its segments vote for.
+  ScanContextDatabase scan_contexts;
   std::string source;  // the file it was loaded from, for messages; empty for a map in memory
 
   size_t size() const { return segments.size(); }
@@ -52,6 +56,12 @@ struct TargetMapBuilderConfig {
   // with fewer of them (sparse scans, a wake-up) sees it as one of the earlier observations did:
   // its centroid and descriptor match those, not the final one's (README, KITTI 1576).
   double earlier_observations_apart_m = 0.0;
+  // A map that stores segment points (max_points_per_segment > 0, which relocalization needs)
+  // also stores the scan context of a mapped scan every this many metres of driving (0: none):
+  // one scan's segments are partial and few, its scan context is whole, and on a sparse rig (a
+  // VLP-32) it finds places the segments do not vote for (relocalizer.h). Off by default: at
+  // about 2.4 kB each, every metre, they would outweigh the segments of a map many times over.
+  double scan_context_apart_m = 0.0;
 };
 
 // Collects finished segments of a mapping run into a target map.
@@ -63,6 +73,10 @@ class TargetMapBuilder {
   void add(const MapSegment& segment, const Eigen::VectorXf& descriptor);
   // The settings the segments were made with (pipeline/map_parameters.h), copied into the map.
   void setParameters(MapParameters parameters) { parameters_ = std::move(parameters); }
+  // A mapped scan's scan context, made in the frame T_map_scan (levelled: z up).
+  void addScan(ScanContext context, const Pose& T_map_scan) {
+    scans_.add(std::move(context), T_map_scan);
+  }
   size_t duplicatesRemoved() const { return duplicates_; }
   TargetMap build() const;
 
@@ -71,6 +85,7 @@ class TargetMapBuilder {
   int dimension_;
   TargetMapBuilderConfig config_;
   MapParameters parameters_;
+  ScanContextDatabase scans_;
   std::vector<MapSegment> segments_;
   std::vector<Eigen::VectorXf> descriptors_;
   std::vector<bool> alive_;

@@ -147,7 +147,7 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
                                  [](const LocalizationRecord& r) { return r.refined; });
   nlohmann::ordered_json by_path;
   for (LocalizationPath p : {LocalizationPath::kLocalMap, LocalizationPath::kLatestScan,
-                             LocalizationPath::kRelocalization})
+                             LocalizationPath::kRelocalization, LocalizationPath::kScanContext})
     by_path[localizationPathName(p)] =
         std::count_if(run.localizations.begin(), run.localizations.end(),
                       [p](const LocalizationRecord& r) { return r.path == p; });

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "semsegmap/core/diagnostics.h"
+#include "semsegmap/localize/registration_check.h"
 #include "semsegmap/pipeline/map_parameters.h"
 
 namespace semsegmap {
@@ -58,8 +60,23 @@ MappingSession::MappingSession(const PipelineConfig& config, const DatasetInfo& 
                                const FrontEndStages& stages)
     : config_(config),
       pipeline_(config, info, poses, describer, stages),
-      builder_(builderFor(requireDescriber(describer, "MappingSession"), config.target_map)) {
+      builder_(builderFor(requireDescriber(describer, "MappingSession"), config.target_map)),
+      T_base_lidar_(info.rig.T_base_lidar) {
   builder_.setParameters(mapParametersOf(config));
+}
+
+// The scan context of a scan every target_map.scan_context_apart_m, for a map a relocalization can
+// use (one with segment points): made in the LiDAR's frame turned level with the base.
+void MappingSession::keepScanContext(const Frame& frame, const Pose& T_local_base) {
+  const TargetMapBuilderConfig& c = config_.target_map;
+  if (c.max_points_per_segment == 0 || c.scan_context_apart_m <= 0) return;
+  const Pose T_local_scan = scanContextFrame(T_local_base, T_base_lidar_);
+  if (last_scan_context_ &&
+      (T_local_scan.translation() - *last_scan_context_).norm() < c.scan_context_apart_m)
+    return;
+  last_scan_context_ = T_local_scan.translation();
+  builder_.addScan(makeScanContext(frame.points, ScanContextConfig{}, T_base_lidar_.linear()),
+                   T_local_scan);
 }
 
 void MappingSession::add(const std::vector<Segment>& segments,
@@ -147,6 +164,7 @@ std::vector<SegmentId> MappingSession::segmentsWithEarlierObservations() const {
 void MappingSession::process(const Frame& frame) {
   const FrameResult r = pipeline_.process(frame);
   run_.trajectory.push_back(r.T_local_base);
+  keepScanContext(frame, r.T_local_base);
   keepEarlierObservations(r);
   add(r.segmentation.finished, r.finished_descriptors);
   forgetVanishedSegments();
@@ -192,7 +210,22 @@ std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map
         ": stores no segment points, which localization.relocalization needs to check a "
         "pose: build it with target_map.max_points_per_segment (map --points N) or turn "
         "relocalization off");
+  if (config.localization.relocalization.enabled &&
+      config.localization.relocalization.scan_context && map->scan_contexts.size() == 0)
+    note(name +
+         ": holds no scan contexts, so a relocalization checks only the places its segments "
+         "vote for (build the map with target_map.scan_context_apart_m: 1.0 to add them)");
   return map;
+}
+}  // namespace
+
+namespace {
+// Each local segment's points, as its latest observation holds them.
+std::vector<std::vector<Eigen::Vector3f>> segmentPoints(const Pipeline& pipeline,
+                                                        const LocalSegmentQuery& q) {
+  std::vector<std::vector<Eigen::Vector3f>> points(q.ids.size());
+  for (size_t i = 0; i < points.size(); ++i) points[i] = pipeline.observedPoints(q.ids[i]);
+  return points;
 }
 }  // namespace
 
@@ -247,6 +280,7 @@ LocalizationSession::Outcome LocalizationSession::localizeFrame(
     bool relocalize, const std::optional<RelocalizationPrior>& prior) const {
   Outcome o;
   o.attempt = attempt(pipeline);
+  if (relocalize) requireRegistration(pipeline, frame, T_local_base, o.attempt);
   const Pipeline* tried = &pipeline;
   Pose base = T_local_base;
   std::optional<Pipeline> scan;
@@ -256,12 +290,14 @@ LocalizationSession::Outcome LocalizationSession::localizeFrame(
     // The scan as the front-end stages left it: labelled and posed.
     base = scan->process(pipeline.processedFrame(frame)).T_local_base;
     o.attempt = attempt(*scan);
+    if (relocalize) requireRegistration(*scan, frame, base, o.attempt);
     o.path = LocalizationPath::kLatestScan;
     tried = &*scan;
   }
   if (!o.attempt.found && relocalize) {
-    o.attempt = attemptRelocalization(*tried, base, prior);
-    o.path = LocalizationPath::kRelocalization;
+    o.attempt = attemptRelocalization(*tried, frame, base, prior);
+    o.path = o.attempt.by_scan_context ? LocalizationPath::kScanContext
+                                       : LocalizationPath::kRelocalization;
   }
   if (o.attempt.found) o.T_map_base = o.attempt.found->T_map_local * base;
   return o;
@@ -278,19 +314,50 @@ LocalizationSession::Attempt LocalizationSession::attempt(const Pipeline& pipeli
   return a;
 }
 
+// While lost, a pose from the local map or the latest scan must pass the relocalization's
+// registration check too: a robot waking up where the map has nothing can find six consistent
+// matches somewhere (the simulator's VLP-32 did, at a third of its wake-ups away from the map).
+void LocalizationSession::requireRegistration(const Pipeline& pipeline, const Frame& frame,
+                                              const Pose& T_local_base, Attempt& a) const {
+  if (!a.found) return;
+  const RelocalizationConfig& config = config_.localization.relocalization;
+  RegistrationCheck c =
+      checkRegistration(segmentPoints(pipeline, a.query), T_local_base.translation(),
+                        localizer_.map(), a.found->T_map_local, config.check);
+  corroborate(c, localizer_.map(), scanContextQuery(frame, T_local_base), config);
+  if (!c.accepted) {
+    a.found.reset();
+    a.refined.reset();
+    return;
+  }
+  a.found->T_map_local = c.T_map_local;
+  a.fitness = c.fitness;
+}
+
+// The scan's scan context on the map's grid, when the map holds scan contexts and the
+// relocalization uses them.
+std::optional<ScanContextQuery> LocalizationSession::scanContextQuery(
+    const Frame& frame, const Pose& T_local_base) const {
+  const ScanContextDatabase& scans = localizer_.map().scan_contexts;
+  if (!config_.localization.relocalization.scan_context || scans.size() == 0) return std::nullopt;
+  const Pose& T_base_lidar = info_.rig.T_base_lidar;
+  return ScanContextQuery{makeScanContext(frame.points, scans.config(), T_base_lidar.linear()),
+                          scanContextFrame(T_local_base, T_base_lidar)};
+}
+
 LocalizationSession::Attempt LocalizationSession::attemptRelocalization(
-    const Pipeline& pipeline, const Pose& T_local_base,
+    const Pipeline& pipeline, const Frame& frame, const Pose& T_local_base,
     const std::optional<RelocalizationPrior>& prior) const {
   Attempt a;
   a.query = pipeline.localSegmentQuery();
-  std::vector<std::vector<Eigen::Vector3f>> points(a.query.ids.size());
-  for (size_t i = 0; i < points.size(); ++i) points[i] = pipeline.observedPoints(a.query.ids[i]);
-  const std::optional<Relocalization> r =
-      semsegmap::relocalize(localizer_, a.query.centroids, a.query.descriptors, points,
-                            T_local_base.translation(), config_.localization.relocalization, prior);
+  const std::vector<std::vector<Eigen::Vector3f>> points = segmentPoints(pipeline, a.query);
+  const std::optional<Relocalization> r = semsegmap::relocalize(
+      localizer_, a.query.centroids, a.query.descriptors, points, T_local_base.translation(),
+      config_.localization.relocalization, prior, scanContextQuery(frame, T_local_base));
   if (r) {
     a.found = r->match;
     a.fitness = r->check.fitness;
+    a.by_scan_context = r->by_scan_context;
   }
   return a;
 }
@@ -362,6 +429,8 @@ const char* localizationPathName(LocalizationPath path) {
       return "latest-scan";
     case LocalizationPath::kRelocalization:
       return "relocalization";
+    case LocalizationPath::kScanContext:
+      return "scan-context";
   }
   return "?";
 }

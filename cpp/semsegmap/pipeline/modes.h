@@ -69,6 +69,7 @@ class MappingSession {
   void add(const std::vector<Segment>& segments, const std::vector<Eigen::VectorXf>& d);
   void keepEarlierObservations(const FrameResult& r);
   void forgetVanishedSegments();
+  void keepScanContext(const Frame& frame, const Pose& T_local_base);
   struct KeptObservation {
     MapSegment segment;
     Eigen::VectorXf descriptor;
@@ -82,6 +83,8 @@ class MappingSession {
   PipelineConfig config_;
   Pipeline pipeline_;
   TargetMapBuilder builder_;
+  Pose T_base_lidar_;
+  std::optional<Eigen::Vector3d> last_scan_context_;  // where the last one was made
   MappingRun run_;
   // Per segment still in the local map, the earlier observations the map keeps
   // (target_map.earlier_observations_apart_m).
@@ -94,7 +97,7 @@ MappingRun runMapping(FrameSource& source, const PipelineConfig& config, PoseSou
 // Which segments gave a localization: the local map's, the latest scan's own
 // (localization.latest_scan_fallback_m), or those of a relocalization against the whole map
 // (localization.relocalization).
-enum class LocalizationPath { kLocalMap, kLatestScan, kRelocalization };
+enum class LocalizationPath { kLocalMap, kLatestScan, kRelocalization, kScanContext };
 const char* localizationPathName(LocalizationPath path);  // "local-map", ...
 
 struct LocalizationRecord {
@@ -159,11 +162,17 @@ class LocalizationSession {
     std::optional<Localization> found;
     std::optional<Refinement> refined;
     std::optional<double> fitness;  // of a relocalization's registration check
+    bool by_scan_context = false;   // the relocalization's pose was the scan context's
     LocalSegmentQuery query;
   };
   Attempt attempt(const Pipeline& pipeline) const;
-  Attempt attemptRelocalization(const Pipeline& pipeline, const Pose& T_local_base,
+  Attempt attemptRelocalization(const Pipeline& pipeline, const Frame& frame,
+                                const Pose& T_local_base,
                                 const std::optional<RelocalizationPrior>& prior) const;
+  void requireRegistration(const Pipeline& pipeline, const Frame& frame, const Pose& T_local_base,
+                           Attempt& a) const;
+  std::optional<ScanContextQuery> scanContextQuery(const Frame& frame,
+                                                   const Pose& T_local_base) const;
   struct Outcome {
     Attempt attempt;
     LocalizationPath path = LocalizationPath::kLocalMap;

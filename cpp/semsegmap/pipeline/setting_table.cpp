@@ -252,6 +252,14 @@ std::vector<Setting> relocalizationSettings() {
              "and turn it this much"),
       number(SEMSEGMAP_AT(localization.relocalization.check.place_radius_m), kNotRecorded,
              "map points this near the robot are registered to"),
+      flag(SEMSEGMAP_AT(localization.relocalization.scan_context), kNotRecorded,
+           "the map's nearest scan context proposes a place too (maps that hold them)"),
+      number(SEMSEGMAP_AT(localization.relocalization.scan_context_max_distance), kNotRecorded,
+             "a scan context this near or farther proposes nothing"),
+      count(SEMSEGMAP_AT(localization.relocalization.scan_context_candidates), 1, 100000,
+            kNotRecorded, "mapped scans with the nearest ring keys compared in full"),
+      number(SEMSEGMAP_AT(localization.relocalization.scan_context_min_fitness), kNotRecorded,
+             "a lower fitness the map's scan contexts near the pose corroborate"),
   };
 }
 
@@ -264,6 +272,8 @@ std::vector<Setting> mapAndLoopSettings() {
             "points kept per map segment (pictures, pose refinement)"),
       number(SEMSEGMAP_AT(target_map.earlier_observations_apart_m), kNotRecorded,
              "keep earlier observations this far apart (0: the final one alone)"),
+      number(SEMSEGMAP_AT(target_map.scan_context_apart_m), kNotRecorded,
+             "with segment points, keep a scan context this often (0: none)"),
       number(SEMSEGMAP_AT(loop_closure.exclude_recent_m), kNotRecorded,
              "segments finished within this much driving are no loop candidates"),
       number(SEMSEGMAP_AT(loop_closure.min_travel_between_loops_m), kNotRecorded,

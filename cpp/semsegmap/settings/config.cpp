@@ -250,6 +250,10 @@ void checkRelocalizationSettings(const std::filesystem::path& path, const Reloca
   check(r.min_fitness >= 0 && r.min_fitness <= 1, "check.min_fitness: must be in [0, 1]");
   check(r.max_correction_m > 0 && r.max_correction_deg > 0,
         "check: max_correction_m and max_correction_deg must be positive");
+  check(c.scan_context_max_distance >= 0 && c.scan_context_max_distance <= 1,
+        "scan_context_max_distance: must be in [0, 1]");
+  check(c.scan_context_min_fitness >= 0 && c.scan_context_min_fitness <= 1,
+        "scan_context_min_fitness: must be in [0, 1]");
 }
 
 // The cross-field checks and the limits a number has beyond being finite, of the sections read.
@@ -285,6 +289,8 @@ void checkPipelineSettings(const std::filesystem::path& path, const Settings& c)
   check(c.target_map.earlier_observations_apart_m >= 0 &&
             c.target_map.earlier_observations_apart_m <= 1000,
         "target_map.earlier_observations_apart_m: must be in [0, 1000]");
+  check(c.target_map.scan_context_apart_m >= 0,
+        "target_map.scan_context_apart_m: must not be negative");
   const auto& rf = loc.refinement;
   check(rf.fine_distance_m > 0 && rf.coarse_distance_m >= rf.fine_distance_m,
         "localization.refinement: need 0 < fine_distance_m <= coarse_distance_m");
