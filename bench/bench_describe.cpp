@@ -110,6 +110,8 @@ BENCHMARK(BM_LearnedDescribe)
 
 // The input preparation alone (subsampling, grids), single-threaded: its share of the above.
 void BM_LearnedNetInput(benchmark::State& state) {
+  // The benchmarks after it run OpenMP loops in this thread (learned_describer.h).
+  const KeepOpenMpThreads keep;
   torch::set_num_threads(1);
   NetConfig config;
   config.kind = static_cast<DescriptorKind>(state.range(0));

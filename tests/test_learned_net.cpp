@@ -2,6 +2,7 @@
 // flow, model files, inference invariances, and that a small network can learn at all.
 #include <gtest/gtest.h>
 
+#include <omp.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <thread>
 
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/binary_io.h"
@@ -134,6 +136,26 @@ void expectFileError(F f, const std::filesystem::path& path, const std::string& 
 
 torch::Tensor pairwiseDistances(const torch::Tensor& d) {
   return torch::cdist(d.unsqueeze(0), d.unsqueeze(0)).squeeze(0);
+}
+
+// A thread's first use of torch set its OpenMP thread count to one, and the enrichment's loops
+// in that thread then ran on one core (7 -> 12-14 ms a frame): loading a describer leaves the
+// calling thread's count as it was. A fresh thread, because torch does it once per thread.
+TEST(ModelFile, LoadingADescriberLeavesTheThreadsOpenMpCountAlone) {
+  int before = 0, after = 0;
+  std::thread fresh([&] {
+    omp_set_num_threads(2);
+    before = omp_get_max_threads();
+    DescriptorConfig config;
+    config.kind = "semsegmap-net";
+    config.model =
+        (std::filesystem::path(SEMSEGMAP_SOURCE_DIR) / "models" / "semsegmap-net.model").string();
+    const auto describer = makeDescriber(config);
+    after = omp_get_max_threads();
+  });
+  fresh.join();
+  EXPECT_EQ(before, 2);
+  EXPECT_EQ(after, before);
 }
 
 }  // namespace

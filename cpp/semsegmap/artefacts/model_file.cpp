@@ -7,6 +7,7 @@
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/binary_io.h"
 #if SEMSEGMAP_WITH_TORCH
+#include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/describe/learned_net.h"
 #endif
 
@@ -171,6 +172,8 @@ std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int thr
   DescriberOptions options;
   options.threads = threads;
 #if SEMSEGMAP_WITH_TORCH
+  // Loading the network is the calling thread's first use of torch (learned_describer.h).
+  const KeepOpenMpThreads keep;
   if (kind == DescriptorKind::kSemSegMapNet || kind == DescriptorKind::kSegMapCnn) {
     if (config.model.empty())
       throw std::invalid_argument("descriptor.kind " + config.kind +

@@ -144,6 +144,11 @@ class LearnedDescriber : public Describer {
 
 }  // namespace
 
+KeepOpenMpThreads::KeepOpenMpThreads() : threads_(omp_get_max_threads()) {}
+KeepOpenMpThreads::~KeepOpenMpThreads() {
+  omp_set_num_threads(threads_);
+}
+
 void keepFreedMemoryForTorch() {
 #ifdef __GLIBC__
   static const bool once = [] {

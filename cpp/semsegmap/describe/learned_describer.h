@@ -27,4 +27,20 @@ constexpr int kLearnedChunk = 64;
 // Idempotent, a no-op elsewhere than glibc.
 void keepFreedMemoryForTorch();
 
+// A thread's first use of torch sets that thread's OpenMP thread count (to one, with Debian's
+// libtorch on the 2-core machine), and every later OpenMP loop of the thread then runs on one
+// core: the enrichment after a describer was loaded took 12-14 ms a frame instead of 7
+// (BM_PipelineFrontEnd with and without a describer). The guard puts the count back when it
+// goes out of scope; makeDescriber holds one while it loads a network.
+class KeepOpenMpThreads {
+ public:
+  KeepOpenMpThreads();
+  ~KeepOpenMpThreads();
+  KeepOpenMpThreads(const KeepOpenMpThreads&) = delete;
+  KeepOpenMpThreads& operator=(const KeepOpenMpThreads&) = delete;
+
+ private:
+  int threads_;
+};
+
 }  // namespace semsegmap
