@@ -88,6 +88,7 @@ std::string modelFile(DescriptorKind kind) {
 
 // state.range(0): descriptor kind (2 segmap-cnn, 3 semsegmap-net); range(1): threads.
 void BM_LearnedDescribe(benchmark::State& state) {
+  const KeepOpenMpThreads keep;  // later benchmarks run OpenMP loops in this thread
   const auto kind = static_cast<DescriptorKind>(state.range(0));
   keepFreedMemoryForTorch();  // as the command line does at start-up
   const auto describer = makeLearnedDescriber(

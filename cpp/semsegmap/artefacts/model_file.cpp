@@ -150,6 +150,7 @@ void saveNet(const std::filesystem::path& path, DescriptorNetImpl& net) {
 
 std::shared_ptr<DescriptorNetImpl> loadNet(const std::filesystem::path& path,
                                            std::optional<DescriptorKind> expected) {
+  const KeepOpenMpThreads keep;  // often the calling thread's first use of torch
   const Model model = readModelFile(path, expected);
   try {
     return netFromModel(model);
