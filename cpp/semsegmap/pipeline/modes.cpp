@@ -217,9 +217,7 @@ std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map
          "vote for (build the map with target_map.scan_context_apart_m: 1.0 to add them)");
   return map;
 }
-}  // namespace
 
-namespace {
 // Each local segment's points, as its latest observation holds them.
 std::vector<std::vector<Eigen::Vector3f>> segmentPoints(const Pipeline& pipeline,
                                                         const LocalSegmentQuery& q) {
@@ -324,7 +322,8 @@ void LocalizationSession::requireRegistration(const Pipeline& pipeline, const Fr
   RegistrationCheck c =
       checkRegistration(segmentPoints(pipeline, a.query), T_local_base.translation(),
                         localizer_.map(), a.found->T_map_local, config.check);
-  corroborate(c, localizer_.map(), scanContextQuery(frame, T_local_base), config);
+  // The scan context only matters to a pose the points alone did not accept.
+  if (!c.accepted) corroborate(c, localizer_.map(), scanContextQuery(frame, T_local_base), config);
   if (!c.accepted) {
     a.found.reset();
     a.refined.reset();
