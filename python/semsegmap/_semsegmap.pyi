@@ -233,6 +233,7 @@ class RegistrationCheckConfig:
     _fields: tuple[str, ...]
     max_points_per_segment: int
     coarse_distance_m: float
+    retry_coarse_distance_m: float
     fine_distance_m: float
     kernel_scale_m: float
     near_m: float

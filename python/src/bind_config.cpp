@@ -87,6 +87,7 @@ void bindLocalizationConfigs(py::module_& m) {
   StructBinding<RC>(m, "RegistrationCheckConfig", "localize/registration_check.h")
       .field("max_points_per_segment", &RC::max_points_per_segment)
       .field("coarse_distance_m", &RC::coarse_distance_m)
+      .field("retry_coarse_distance_m", &RC::retry_coarse_distance_m)
       .field("fine_distance_m", &RC::fine_distance_m)
       .field("kernel_scale_m", &RC::kernel_scale_m)
       .field("near_m", &RC::near_m)

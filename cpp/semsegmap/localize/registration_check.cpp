@@ -50,6 +50,36 @@ double overlap(const std::vector<Eigen::Vector3d>& points, const VoxelMap& map, 
   return points.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(points.size());
 }
 
+// The coarse registration from the proposed pose, with correspondences within distance_m, and
+// the share of the points then within near_m of the map's.
+struct CoarsePass {
+  IcpResult icp;
+  double fine_overlap = 0.0;
+};
+
+CoarsePass coarsePass(const std::vector<Eigen::Vector3d>& few, const VoxelMap& coarse,
+                      const VoxelMap& fine, const Pose& proposed, double distance_m,
+                      const RegistrationCheckConfig& config, const IcpConfig& icp) {
+  CoarsePass out;
+  out.icp = alignToMap(few, coarse, proposed, distance_m, config.kernel_scale_m, icp);
+  if (out.icp.enough_correspondences)
+    out.fine_overlap = overlap(few, fine, out.icp.T, config.near_m);
+  return out;
+}
+
+// The coarse pass again with nearer correspondences (retry_coarse_distance_m), kept when it
+// leaves more of the points on the map's than `first` did.
+CoarsePass retriedNearer(const CoarsePass& first, const std::vector<Eigen::Vector3d>& few,
+                         const std::vector<Eigen::Vector3d>& target, const VoxelMap& fine,
+                         const Pose& proposed, const RegistrationCheckConfig& config,
+                         const IcpConfig& icp) {
+  VoxelMap nearer(config.retry_coarse_distance_m, 32);
+  nearer.add(target, target);
+  CoarsePass again =
+      coarsePass(few, nearer, fine, proposed, config.retry_coarse_distance_m, config, icp);
+  return again.fine_overlap > first.fine_overlap ? again : first;
+}
+
 }  // namespace
 
 RegistrationCheck checkRegistration(const std::vector<std::vector<Eigen::Vector3f>>& local_points,
@@ -89,20 +119,22 @@ RegistrationCheck checkRegistration(const std::vector<std::vector<Eigen::Vector3
     return refused(T_map_local, apart);
   IcpConfig icp;
   icp.min_correspondences = std::min(config.min_points, few.size());
-  IcpResult r =
-      alignToMap(few, coarse, proposed, config.coarse_distance_m, config.kernel_scale_m, icp);
-  if (!r.enough_correspondences) return refused(T_map_local, apart);
-  if (overlap(few, fine, r.T, config.near_m) < config.min_fitness / 2)
-    return refused(r.T * Eigen::Translation3d(-c), "the points do not lie on the map's");
+  CoarsePass r = coarsePass(few, coarse, fine, proposed, config.coarse_distance_m, config, icp);
+  if (r.fine_overlap < config.min_fitness && config.retry_coarse_distance_m > 0)
+    r = retriedNearer(r, few, target, fine, proposed, config, icp);
+  if (!r.icp.enough_correspondences) return refused(T_map_local, apart);
+  if (r.fine_overlap < config.min_fitness / 2)
+    return refused(r.icp.T * Eigen::Translation3d(-c), "the points do not lie on the map's");
   icp.min_correspondences = config.min_points;
-  r = alignToMap(local, fine, r.T, config.fine_distance_m, config.kernel_scale_m, icp);
-  if (!r.enough_correspondences) return refused(T_map_local, apart);
+  const IcpResult f =
+      alignToMap(local, fine, r.icp.T, config.fine_distance_m, config.kernel_scale_m, icp);
+  if (!f.enough_correspondences) return refused(T_map_local, apart);
   RegistrationCheck out;
-  out.T_map_local = r.T * Eigen::Translation3d(-c);
+  out.T_map_local = f.T * Eigen::Translation3d(-c);
   out.points = local.size();
-  out.correction_m = translationError(r.T, proposed);
-  out.correction_deg = rotationErrorDeg(r.T, proposed);
-  out.fitness = overlap(local, fine, r.T, config.near_m);
+  out.correction_m = translationError(f.T, proposed);
+  out.correction_deg = rotationErrorDeg(f.T, proposed);
+  out.fitness = overlap(local, fine, f.T, config.near_m);
   if (out.correction_m > config.max_correction_m || out.correction_deg > config.max_correction_deg)
     out.reason = "registration moved the pose too far";
   else if (out.fitness < config.min_fitness)

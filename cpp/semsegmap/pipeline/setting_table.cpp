@@ -236,6 +236,8 @@ std::vector<Setting> relocalizationSettings() {
             kNotRecorded, "local points a segment contributes to the check"),
       number(SEMSEGMAP_AT(localization.relocalization.check.coarse_distance_m), kNotRecorded,
              "correspondence distance of the check's coarse pass"),
+      number(SEMSEGMAP_AT(localization.relocalization.check.retry_coarse_distance_m), kNotRecorded,
+             "a coarse pass leaving the points off the map's is retried this near (0: never)"),
       number(SEMSEGMAP_AT(localization.relocalization.check.fine_distance_m), kNotRecorded,
              "correspondence distance of the check's fine pass"),
       number(SEMSEGMAP_AT(localization.relocalization.check.kernel_scale_m), kNotRecorded,

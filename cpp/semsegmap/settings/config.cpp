@@ -245,6 +245,9 @@ void checkRelocalizationSettings(const std::filesystem::path& path, const Reloca
   const RegistrationCheckConfig& r = c.check;
   check(r.fine_distance_m > 0 && r.coarse_distance_m >= r.fine_distance_m,
         "check: need 0 < fine_distance_m <= coarse_distance_m");
+  check(r.retry_coarse_distance_m == 0 || (r.retry_coarse_distance_m >= r.fine_distance_m &&
+                                           r.retry_coarse_distance_m < r.coarse_distance_m),
+        "check.retry_coarse_distance_m: 0, or in [fine_distance_m, coarse_distance_m)");
   check(r.kernel_scale_m > 0 && r.near_m > 0 && r.place_radius_m > 0,
         "check: kernel_scale_m, near_m and place_radius_m must be positive");
   check(r.min_fitness >= 0 && r.min_fitness <= 1, "check.min_fitness: must be in [0, 1]");
