@@ -15,6 +15,11 @@ packages=(
   libsqlite3-dev libfastcdr-dev libzstd-dev liblz4-dev
   librosbag-storage-dev libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev
   libtf2-msgs-dev
+  # the ROS 1 node (ros/, SEMSEGMAP_WITH_ROS1_NODE) and its live test: a master, roslaunch,
+  # rosbag play and record, rostopic
+  libroscpp-dev libtf2-ros-dev libtopic-tools-dev libdiagnostic-msgs-dev libstd-srvs-dev
+  libvisualization-msgs-dev
+  python3-rosmaster python3-roslaunch python3-rosbag python3-rostopic python3-std-srvs rosout
   gnuplot-nox
   # the tests and the benchmark generate their small ONNX segmentation networks with it
   python3-onnx python3-numpy

@@ -234,6 +234,10 @@ BENCHMARKS = [
     ("BM_LocalizationQuery/1000000", "... 1M segments", "<= 30 ms", "ms"),
     ("BM_Relocalize", "relocalization from one scan (120k points in its segments, the 64 "
      "nearest of each, places, registration check) against 10k segments", "<= 150 ms", "ms"),
+    ("BM_LiveLatency/10", "live session, S2 scans arriving at 10 Hz with their pictures and "
+     "odometry: a scan's arrival to its pose", "<= 100 ms", "latency"),
+    ("BM_LiveLatency/40", "the same fed at 40 Hz, faster than it works: it drops, its queue "
+     "stays bounded", "", "latency"),
 ]
 
 TO_MS = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
@@ -249,6 +253,11 @@ def benchmark_cell(b, unit):
         return f"{ms:.1f} ms (search {b['search_ms']:.1f} ms)"
     if "map_seg_ms" in b:
         return f"{ms:.1f} ms (local map + segmentation {b['map_seg_ms']:.1f} ms)"
+    if unit == "latency":
+        return (f"{b['latency_ms']:.1f} ms on average (the pipeline's own "
+                f"{b['pipeline_ms']:.1f}), {b['max_latency_ms']:.0f} at most; "
+                f"{b['dropped']:.0f} of {b['processed'] + b['dropped']:.0f} frames dropped, "
+                f"at most {b['max_queued']:.0f} queued")
     if "relocalized" in b:
         return (f"{ms:.1f} ms ({100 * b['relocalized']:.0f} % relocalized, "
                 f"{100 * b['wrong']:.0f} % wrong)")

@@ -24,6 +24,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "command_result.h"
@@ -97,7 +98,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"world-seed", "map"}},
     {"localize",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "map", "out",
-      "max-frames", "allow-config-mismatch", "relocalize", "prior"},
+      "max-frames", "allow-config-mismatch", "relocalize", "prior", "follow", "follow-idle"},
      {"poses", "float32"}},
     {"slam",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
@@ -2126,6 +2127,85 @@ TEST(CliRealRig, AFrontCameraOnA360DegreeLidarMapsAndLocalizesWithANetworksLabel
                          (tmp.path() / "keep-dynamic.yaml").string()),
             without_labels);
   EXPECT_GT(without_labels, 40u);
+}
+
+TEST(CliFollow, FollowIdleWithoutFollowOrNotPositiveIsAUsageError) {
+  const std::string base =
+      "localize --dataset folder:nowhere --config config/lidar-camera.yaml --map m.map --out o";
+  Result r = run(base + " --follow-idle 2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("give --follow too"), std::string::npos) << r.err;
+  r = run(base + " --follow --follow-idle -1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--follow-idle: expected a positive number"), std::string::npos) << r.err;
+  r =
+      run("localize --dataset kitti-raw:nowhere --config config/lidar-camera.yaml --map m.map "
+          "--out o --follow");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("give --dataset folder:DIR"), std::string::npos) << r.err;
+}
+
+// A robot without ROS: `localize --follow` on a folder a driver writes the real KITTI 00 scans
+// into (renamed into place, named by their times, 0.3 s apart) localizes them as they come against
+// a map of the same scans, prints each pose when found and, told to stop after 2 s without a new
+// scan, writes the run's files. Whatever it drops when it falls behind (with 2 cores shared by
+// other tests it may), every scan is either worked on or dropped and said; with nothing dropped
+// it localizes as many frames as the offline run.
+TEST(CliFollow, AFolderAsADriverWritesItIsLocalizedAsItGrows) {
+  const std::filesystem::path sample =
+      std::filesystem::path(SEMSEGMAP_SHARED_DATA) / "kitti00_first10_pcd";
+  if (!std::filesystem::exists(sample))
+    GTEST_SKIP() << "the real KITTI 00 PCD scans (../shared/data/kitti00_first10_pcd) are absent";
+  if (!SEMSEGMAP_WITH_PCL)
+    GTEST_SKIP() << "PCD files are read with PCL, which this build leaves out";
+  if (!SEMSEGMAP_WITH_TORCH) GTEST_SKIP() << "config/lidar-camera.yaml's descriptor needs libtorch";
+  TempDir tmp;
+  const std::string config = " --config config/lidar-camera.yaml";
+  const std::string map = (tmp.path() / "k.map").string();
+  const std::string offline = " --dataset folder:" + sample.string() + " --odometry lidar";
+  Result r = run("map" + offline + config + " --out " + map);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("localize" + offline + config + " --map " + map + " --out " +
+          (tmp.path() / "offline").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const size_t at = r.out.find("localizations ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const unsigned long offline_localizations = std::stoul(r.out.substr(at + 14));
+  ASSERT_GT(offline_localizations, 5u) << r.out;
+
+  const std::filesystem::path live = tmp.path() / "live";
+  std::filesystem::create_directories(live);
+  std::thread driver([&] {
+    for (int k = 0; k < 10; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      const std::string stamp = "1317000000." + std::to_string(k) + "00000";
+      std::filesystem::copy_file(sample / ("00000" + std::to_string(k) + ".pcd"),
+                                 live / (stamp + ".pcd.part"));
+      std::filesystem::rename(live / (stamp + ".pcd.part"), live / (stamp + ".pcd"));
+    }
+  });
+  r = run("localize --dataset folder:" + live.string() + " --follow --follow-idle 2" + config +
+          " --map " + map + " --out " + (tmp.path() / "followed").string());
+  driver.join();
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("poses from LiDAR odometry on its scans"), std::string::npos) << r.err;
+  const std::smatch m = [&] {
+    std::smatch found;
+    std::regex_search(r.out, found,
+                      std::regex("followed (\\d+) scans: (\\d+) worked on, (\\d+) dropped"));
+    return found;
+  }();
+  ASSERT_EQ(m.size(), 4u) << r.out;
+  EXPECT_EQ(std::stoul(m[1]), 10u) << r.out;
+  EXPECT_EQ(std::stoul(m[2]) + std::stoul(m[3]), 10u) << r.out;
+  size_t printed = 0;
+  for (size_t p = r.out.find("pose t=1317000000."); p != std::string::npos;
+       p = r.out.find("pose t=1317000000.", p + 1))
+    ++printed;
+  EXPECT_EQ(lines(readFile(tmp.path() / "followed" / "localizations.csv")), printed + 1);
+  if (std::stoul(m[3]) == 0) {
+    EXPECT_EQ(printed, offline_localizations) << r.out;
+  }
 }
 
 }  // namespace

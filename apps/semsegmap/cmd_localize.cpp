@@ -12,6 +12,7 @@
 #include "cli_args.h"
 #include "dataset_args.h"
 #include "interrupt.h"
+#include "localize_follow.h"
 #include "progress.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -68,7 +69,18 @@ std::optional<RelocalizationPrior> priorOf(const CliArgs& a, const PipelineConfi
   return prior;
 }
 
+void writeLocalizeFiles(const CliArgs& a, const LocalizationRun& run, const TargetMap& map,
+                        const std::string& dataset);
+void printWritten(const CliArgs& a);
+
 int runLocalize(const CliArgs& a) {
+  if (a.has("follow") && a.get("dataset").rfind("folder:", 0) != 0)
+    throw UsageError("--follow follows a folder a driver writes into: give --dataset folder:DIR");
+  if (a.has("follow-idle") && !a.has("follow"))
+    throw UsageError("--follow-idle says when --follow stops: give --follow too");
+  if (a.has("follow-idle") && !(a.getNumber("follow-idle") > 0))
+    throw UsageError("--follow-idle: expected a positive number of seconds, got " +
+                     a.get("follow-idle"));
   PipelineConfig config = loadPipelineConfig(a.get("config"));
   if (a.has("relocalize")) config.localization.relocalization.enabled = true;
   const std::optional<RelocalizationPrior> prior = priorOf(a, config);
@@ -89,6 +101,13 @@ int runLocalize(const CliArgs& a) {
     throw std::runtime_error(map_path.string() + ": map built with " + map->descriptor +
                              " descriptors, the configuration uses " + kind);
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
+  if (a.has("follow")) {
+    FollowedRun followed = followFolder(a, config, map, settings, prior);
+    writeLocalizeFiles(a, followed.run, *map, followed.dataset);
+    printLocalizationSummary(followed.run);
+    printWritten(a);
+    return 0;
+  }
   // The network and LiDAR odometry, when asked for, run inside the pipeline.
   DatasetWithStages data = openDatasetForPipelineArg(a);
   std::unique_ptr<FrameSource>& source = data.source;
@@ -107,28 +126,38 @@ int runLocalize(const CliArgs& a) {
   // Stopped before its first frame: nothing worth writing (main removes what the run made).
   if (run.stats.interrupted && run.stats.frames == 0)
     return interruptedRun("localize", 0, options.frameCount(*source), out.string());
-
-  writeLocalizationsCsv(out / "localizations.csv", run);
-  writeLocalizationDetails(out, run);  // matches.csv, trajectory.csv: for semsegmap view
-  writeLocalizationPicture(out / "localization.png", run, *map,
-                           source->info().name + " against " + map_path.filename().string() + " (" +
-                               std::filesystem::path(a.get("config")).stem().string() + ")");
-  SummaryContext context;
-  context.dataset = source->info().name;
-  context.map = map_path.string();
-  context.config = a.get("config");
-  context.descriptor = map->descriptor;
-  context.map_segments = map->size();
-  context.map_bytes = std::filesystem::file_size(map_path);
-  // Last: a summary says the run completed.
-  writeBytesAtomically(out / "summary.json", localizationSummaryJson(run, context));
-
+  writeLocalizeFiles(a, run, *map, source->info().name);
   printLocalizationSummary(run);
-  std::cout << "wrote " << (out / "localizations.csv").string()
-            << ", matches.csv, trajectory.csv, summary.json, localization.png\n";
+  printWritten(a);
   if (run.stats.interrupted)
     return interruptedRun("localize", run.stats.frames, options.frameCount(*source), out.string());
   return 0;
+}
+
+// localizations.csv, matches.csv, trajectory.csv, localization.png and, last (a summary says the
+// run completed), summary.json.
+void writeLocalizeFiles(const CliArgs& a, const LocalizationRun& run, const TargetMap& map,
+                        const std::string& dataset) {
+  const std::filesystem::path map_path = a.get("map");
+  const std::filesystem::path out = a.get("out");
+  writeLocalizationsCsv(out / "localizations.csv", run);
+  writeLocalizationDetails(out, run);  // matches.csv, trajectory.csv: for semsegmap view
+  writeLocalizationPicture(out / "localization.png", run, map,
+                           dataset + " against " + map_path.filename().string() + " (" +
+                               std::filesystem::path(a.get("config")).stem().string() + ")");
+  SummaryContext context;
+  context.dataset = dataset;
+  context.map = map_path.string();
+  context.config = a.get("config");
+  context.descriptor = map.descriptor;
+  context.map_segments = map.size();
+  context.map_bytes = std::filesystem::file_size(map_path);
+  writeBytesAtomically(out / "summary.json", localizationSummaryJson(run, context));
+}
+
+void printWritten(const CliArgs& a) {
+  std::cout << "wrote " << (std::filesystem::path(a.get("out")) / "localizations.csv").string()
+            << ", matches.csv, trajectory.csv, summary.json, localization.png\n";
 }
 
 }  // namespace
@@ -152,6 +181,11 @@ const CommandSpec& localizeCommand() {
                "(localization.relocalization; the map needs segment points)"},
               {"prior", Value::kText, "X,Y[,RADIUS]", "",
                "relocalize only within RADIUS m (default 50) of X,Y in the map frame"},
+              {"follow", Value::kFlag, "", "",
+               "follow a folder: dataset as a driver writes into it, printing each pose as it "
+               "is found (LiDAR odometry on its scans; files taken once renamed into place)"},
+              {"follow-idle", Value::kText, "SECONDS", "",
+               "with --follow: stop after this long without a new scan (default: at Ctrl-C)"},
           }),
       kDatasetNotes,
       runLocalize,

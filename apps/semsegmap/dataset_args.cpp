@@ -77,7 +77,12 @@ DatasetWithStages openDatasetForPipelineArg(const CliArgs& a) {
 
 std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,
                                         const FrameSource& source) {
-  const DescriptorChoice choice = chooseDescriptor(descriptor, inputModalitiesOf(source.info()));
+  return describerFor(descriptor, source.info());
+}
+
+std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,
+                                        const DatasetInfo& info) {
+  const DescriptorChoice choice = chooseDescriptor(descriptor, inputModalitiesOf(info));
   if (!choice.note.empty()) note(choice.note);
   return makeDescriber(choice.descriptor);
 }

@@ -36,5 +36,7 @@ DatasetWithStages openDatasetForPipelineArg(const CliArgs& a);
 // for a LiDAR without a camera (chooseDescriptor); what was chosen or assumed is printed.
 std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,
                                         const FrameSource& source);
+std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,
+                                        const DatasetInfo& info);
 
 }  // namespace semsegmap::app

@@ -53,19 +53,6 @@ std::vector<float> pointTimesFrom(const FloatIn& a, size_t points) {
   return std::vector<float>(a.data(), a.data() + points);
 }
 
-// (H, W, channels) with channels 3 (colour) or 1 (labels; (H, W) too).
-Image imageFrom(const U8In& a, int channels, const std::string& what) {
-  const bool ok = channels == 3 ? a.ndim() == 3 && a.shape(2) == 3
-                                : a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 1);
-  if (!ok)
-    throw std::invalid_argument(what + ": expected " +
-                                (channels == 3 ? "(H, W, 3) uint8 RGB" : "(H, W) uint8 class ids") +
-                                ", got shape " + shapeText(a));
-  Image image(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)), channels);
-  std::copy(a.data(), a.data() + image.data.size(), image.data.begin());
-  return image;
-}
-
 // Camera k's picture of `images` (a list, None entries for none) into frame.cameras.
 void setImages(Frame& f, const py::object& images, int channels, const char* what) {
   if (images.is_none()) return;
@@ -80,6 +67,19 @@ void setImages(Frame& f, const py::object& images, int channels, const char* wha
 }
 
 }  // namespace
+
+Image imageFrom(const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& a,
+                int channels, const std::string& what) {
+  const bool ok = channels == 3 ? a.ndim() == 3 && a.shape(2) == 3
+                                : a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 1);
+  if (!ok)
+    throw std::invalid_argument(what + ": expected " +
+                                (channels == 3 ? "(H, W, 3) uint8 RGB" : "(H, W) uint8 class ids") +
+                                ", got shape " + shapeText(a));
+  Image image(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)), channels);
+  std::copy(a.data(), a.data() + image.data.size(), image.data.begin());
+  return image;
+}
 
 Frame frameFrom(const FloatIn& points, const py::object& point_labels,
                 const py::object& point_times, const py::object& images,

@@ -35,6 +35,7 @@ void bindCore(py::module_& m);
 void bindConfig(py::module_& m);
 void bindDatasets(py::module_& m);
 void bindDescribe(py::module_& m);
+void bindLive(py::module_& m);
 void bindLocalize(py::module_& m);
 void bindPipeline(py::module_& m);
 void bindSim(py::module_& m);
@@ -135,6 +136,10 @@ EnrichedCloud enrichedCloudFrom(const py::array& a, const std::string& what);
 py::array_t<float> pointsArray(const std::vector<Eigen::Vector3f>& points);
 std::vector<Eigen::Vector3f> pointsFrom(const py::array_t<float, py::array::forcecast>& a,
                                         const std::string& what);
+// (H, W, 3) uint8 colour (channels 3) or (H, W) class ids (channels 1), copied; `what` names
+// the argument in errors.
+Image imageFrom(const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& a,
+                int channels, const std::string& what);
 // A frame from numpy arrays (copied), as Frame(points, ...) takes them.
 Frame frameFrom(const py::array_t<float, py::array::c_style | py::array::forcecast>& points,
                 const py::object& point_labels, const py::object& point_times,

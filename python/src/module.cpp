@@ -40,5 +40,6 @@ PYBIND11_MODULE(_semsegmap, m) {
   bindDescribe(m);
   bindLocalize(m);
   bindPipeline(m);
+  bindLive(m);
   bindSim(m);
 }

@@ -31,12 +31,13 @@ constexpr size_t kMinChunk = 16;
 constexpr size_t kChunksPerBatch = 8;
 
 // torch (and oneDNN) single-threaded in the calling thread for the guard's lifetime; the
-// caller's OpenMP thread count is restored, so its own parallel loops are untouched.
+// caller's OpenMP thread count is restored, so its own parallel loops are untouched. The count
+// is read before torch's first use in the thread, which sets it (to one): a thread that first
+// describes here (the live session's worker) kept one core for its enrichment otherwise.
 class SingleThreadedTorch {
  public:
-  SingleThreadedTorch() {
-    at::get_num_threads();  // torch sets a thread's OpenMP count on first use: do it first
-    saved_ = omp_get_max_threads();
+  SingleThreadedTorch() : saved_(omp_get_max_threads()) {
+    at::get_num_threads();  // torch's per-thread set-up, inside the guard
     omp_set_num_threads(1);
   }
   ~SingleThreadedTorch() { omp_set_num_threads(saved_); }

@@ -27,11 +27,6 @@ std::string lower(std::string s) {
   return s;
 }
 
-bool isPicture(const fs::path& p) {
-  const std::string ext = lower(p.extension().string());
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
-}
-
 // The regular files of `folder` that `keep` accepts, sorted by name.
 std::vector<fs::path> listFiles(const fs::path& folder, bool (*keep)(const fs::path&)) {
   if (!fs::is_directory(folder)) throw std::runtime_error(folder.string() + ": no such folder");
@@ -135,6 +130,11 @@ fs::path parseFolderSpec(const std::string& spec, const std::string& args, Folde
   return dir;
 }
 
+bool isPictureFile(const fs::path& p) {
+  const std::string ext = lower(p.extension().string());
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+}
+
 std::optional<double> timeFromFileName(const std::string& stem) {
   if (stem.empty() || !std::isdigit(static_cast<unsigned char>(stem[0]))) return std::nullopt;
   const size_t dot = stem.find('.');
@@ -171,21 +171,27 @@ std::optional<size_t> FolderReader::frameNumber(size_t index) {
   return numbers_.at(index);
 }
 
-FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : dir_(dir) {
-  if (!fs::is_directory(dir_)) throw std::runtime_error(dir_.string() + ": no such folder");
-  const fs::path rig_path = !options.rig.empty()
-                                ? options.rig
-                                : (fs::exists(dir_ / "rig.yaml") ? dir_ / "rig.yaml" : fs::path());
+RigFile readFolderRig(const fs::path& dir, const FolderOptions& options, fs::path& rig_path) {
+  if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": no such folder");
+  rig_path = !options.rig.empty() ? options.rig
+                                  : (fs::exists(dir / "rig.yaml") ? dir / "rig.yaml" : fs::path());
   RigFile rig;
-  if (!rig_path.empty()) {
-    rig = readRigFile(rig_path);
-  } else {
-    rig.rig.lidar.hfov_deg = 360.0;
-    rig.rig.rate_hz = 10.0;  // as a rig file without rate_hz
-    note(dir_.string() + " has no rig file (rig.yaml, or " + optionText("rig", "FILE") +
-         "): LiDAR only at " + shownNumber(rig.rig.rate_hz) + " Hz, the base frame is the LiDAR");
-  }
-  info_.name = !rig.name.empty() ? rig.name : "folder:" + fs::absolute(dir_).filename().string();
+  if (!rig_path.empty()) return readRigFile(rig_path);
+  rig.rig.lidar.hfov_deg = 360.0;
+  rig.rig.rate_hz = 10.0;  // as a rig file without rate_hz
+  note(dir.string() + " has no rig file (rig.yaml, or " + optionText("rig", "FILE") +
+       "): LiDAR only at " + shownNumber(rig.rig.rate_hz) + " Hz, the base frame is the LiDAR");
+  return rig;
+}
+
+std::string folderName(const fs::path& dir, const RigFile& rig) {
+  return !rig.name.empty() ? rig.name : "folder:" + fs::absolute(dir).filename().string();
+}
+
+FolderReader::FolderReader(const fs::path& dir, const FolderOptions& options) : dir_(dir) {
+  fs::path rig_path;
+  const RigFile rig = readFolderRig(dir_, options, rig_path);
+  info_.name = folderName(dir_, rig);
   info_.rig = rig.rig;
   info_.classes = ClassTable::Default();
 
@@ -263,7 +269,7 @@ void checkPictureSize(const Image& picture, const Camera& camera, const fs::path
 
 void FolderReader::pairPictures(size_t camera, const fs::path& folder) {
   const Camera& cam = info_.rig.cameras[camera];
-  const std::vector<fs::path> pictures = listFiles(folder, &isPicture);
+  const std::vector<fs::path> pictures = listFiles(folder, &isPictureFile);
   if (pictures.empty())
     throw std::runtime_error(folder.string() + ": no pictures (.png, .jpg) of camera '" + cam.name +
                              "'");

@@ -31,6 +31,8 @@ struct FolderOptions {
 std::filesystem::path parseFolderSpec(const std::string& spec, const std::string& args,
                                       FolderOptions& options);
 
+// A picture by its extension: .png, .jpg or .jpeg, in any case.
+bool isPictureFile(const std::filesystem::path& path);
 // A file name's stem as a time in seconds: "1650000000.123456" (seconds), or an integer of
 // nanoseconds (>= 18 digits), microseconds (15-17), milliseconds (12-14) or seconds (>= 1e8).
 // Nothing for small integers (frame numbers such as 000042) and for other names.
@@ -38,6 +40,14 @@ std::optional<double> timeFromFileName(const std::string& stem);
 // A file name's stem as a frame number: digits only and no time by timeFromFileName (000042 is
 // 42). Nothing for times and other names.
 std::optional<size_t> frameNumberFromFileName(const std::string& stem);
+
+// The rig of a recording folder: options.rig, else DIR/rig.yaml (its path in `rig_path`), else a
+// LiDAR alone at 10 Hz whose base is the LiDAR (said on stderr; `rig_path` empty). Throws
+// std::runtime_error when DIR is no folder or the rig file is refused.
+RigFile readFolderRig(const std::filesystem::path& dir, const FolderOptions& options,
+                      std::filesystem::path& rig_path);
+// The dataset's name: the rig file's, else "folder:" and the folder's name.
+std::string folderName(const std::filesystem::path& dir, const RigFile& rig);
 
 class FolderReader : public FrameSource {
  public:

@@ -201,4 +201,30 @@ StampedPose stampedPoseOf(const Odometry& msg) {
   return StampedPose{msg.header.stamp_s, poseOf(msg.pose)};
 }
 
+LidarModel lidarModelOf(const PointCloud2& msg, const DecodedCloud& cloud) {
+  LidarModel m;
+  m.rows = cloud.rings > 0 ? cloud.rings : msg.height > 1 ? static_cast<int>(msg.height) : 64;
+  m.columns = msg.height > 1 ? static_cast<int>(msg.width)
+                             : std::max<int>(1, static_cast<int>(cloud.points.size()) / m.rows);
+  m.hfov_deg = 360.0;
+  m.range_noise_m = 0.0;
+  m.dropout = 0.0;
+  m.min_range_m = 0.0;
+  double up = -90, down = 90, far = 0;
+  for (const LidarPoint& p : cloud.points) {
+    const double flat = std::hypot(p.x, p.y), range = std::hypot(flat, p.z);
+    if (range <= 0) continue;
+    const double elevation = std::atan2(p.z, flat) * 180.0 / M_PI;
+    up = std::max(up, elevation);
+    down = std::min(down, elevation);
+    far = std::max(far, range);
+  }
+  if (up > down) {
+    m.vfov_up_deg = up;
+    m.vfov_down_deg = down;
+  }
+  m.max_range_m = far > 1.0 ? far * 1.01 : 100.0;
+  return m;
+}
+
 }  // namespace semsegmap::rosmsg

@@ -33,6 +33,11 @@ struct DecodedCloud {
 // big-endian cloud, a missing coordinate field, or sizes that do not fit the data.
 DecodedCloud decodePointCloud2(const PointCloud2& msg, const std::string& where);
 
+// The LiDAR as one scan shows it: its rings (or the cloud's rows, else 64), the columns they
+// give, its vertical extent and range; 360 degrees across, no noise or dropout (a real scan's
+// are in its points). What a bag reader or a live node knows of a LiDAR without a rig file.
+LidarModel lidarModelOf(const PointCloud2& msg, const DecodedCloud& cloud);
+
 // rgb8, bgr8, rgba8, bgra8, mono8 (grey RGB) and the 8-bit Bayer patterns (bayer_rggb8,
 // bayer_bggr8, bayer_gbrg8, bayer_grbg8, demosaiced) into 3-channel RGB. Throws naming the
 // encoding otherwise, or when step and data do not fit width and height.

@@ -45,11 +45,6 @@ std::string uncompressedTopic(const std::string& topic) {
   return topic;
 }
 
-std::string parentNamespace(const std::string& topic) {
-  const size_t slash = topic.find_last_of('/');
-  return slash == std::string::npos ? std::string() : topic.substr(0, slash);
-}
-
 }  // namespace
 
 namespace {
@@ -85,6 +80,24 @@ void setOption(RosbagOptions& o, const std::string& key, const std::string& valu
 }
 
 }  // namespace
+
+namespace {
+
+std::string parentNamespace(const std::string& topic) {
+  const size_t slash = topic.find_last_of('/');
+  return slash == std::string::npos ? std::string() : topic.substr(0, slash);
+}
+
+}  // namespace
+
+std::string cameraInfoTopic(const std::string& image_topic) {
+  return parentNamespace(uncompressedTopic(image_topic)) + "/camera_info";
+}
+
+std::string cameraNameOfTopic(const std::string& image_topic) {
+  const std::string ns = parentNamespace(uncompressedTopic(image_topic));
+  return ns.empty() || ns == "/" ? image_topic : ns.substr(ns[0] == '/' ? 1 : 0);
+}
 
 RosbagOptions parseRosbagOptions(const std::string& text) {
   RosbagOptions o;
@@ -288,8 +301,7 @@ void RosbagReader::addCamera(const std::string& topic) {
   if (!isImageType(t->type))
     fail("topic " + topic + " is a " + t->type +
          ", not a sensor_msgs/Image or CompressedImage (camera=)");
-  const std::string ns = parentNamespace(uncompressedTopic(topic));
-  const std::string info_topic = ns + "/camera_info";
+  const std::string info_topic = cameraInfoTopic(topic);
   const BagTopic* info = findTopic(topics, info_topic);
   if (!info || info->type != rosmsg::kCameraInfo)
     fail("image topic " + topic + " has no sensor_msgs/CameraInfo on " + info_topic +
@@ -298,7 +310,7 @@ void RosbagReader::addCamera(const std::string& topic) {
   if (info_refs.empty()) fail("topic " + info_topic + " has no messages");
   const rosmsg::CameraInfo ci = rosmsg::parseCameraInfo(bag_->read(info_topic, info_refs.front()));
   Camera cam = rosmsg::cameraFromInfo(ci, path_.string() + ": " + info_topic);
-  cam.name = ns.empty() || ns == "/" ? topic : ns.substr(ns[0] == '/' ? 1 : 0);
+  cam.name = cameraNameOfTopic(topic);
 
   CameraStream c;
   c.topic = topic;
@@ -426,29 +438,8 @@ void RosbagReader::describeLidar() {
   // The LiDAR model is what the first scan shows: its rings or rows, its vertical extent.
   const auto msg = rosmsg::parsePointCloud2(
       bag_->read(lidar_topic_, scans_all_->refs[scans_.empty() ? 0 : scans_.front()]));
-  const auto cloud = rosmsg::decodePointCloud2(msg, path_.string() + ": " + lidar_topic_);
-  LidarModel& m = info_.rig.lidar;
-  m.rows = cloud.rings > 0 ? cloud.rings : msg.height > 1 ? static_cast<int>(msg.height) : 64;
-  m.columns = msg.height > 1 ? static_cast<int>(msg.width)
-                             : std::max<int>(1, static_cast<int>(cloud.points.size()) / m.rows);
-  m.hfov_deg = 360.0;
-  m.range_noise_m = 0.0;
-  m.dropout = 0.0;
-  m.min_range_m = 0.0;
-  double up = -90, down = 90, far = 0;
-  for (const LidarPoint& p : cloud.points) {
-    const double flat = std::hypot(p.x, p.y), range = std::hypot(flat, p.z);
-    if (range <= 0) continue;
-    const double elevation = std::atan2(p.z, flat) * 180.0 / M_PI;
-    up = std::max(up, elevation);
-    down = std::min(down, elevation);
-    far = std::max(far, range);
-  }
-  if (up > down) {
-    m.vfov_up_deg = up;
-    m.vfov_down_deg = down;
-  }
-  m.max_range_m = far > 1.0 ? far * 1.01 : 100.0;
+  info_.rig.lidar = rosmsg::lidarModelOf(
+      msg, rosmsg::decodePointCloud2(msg, path_.string() + ": " + lidar_topic_));
 }
 
 void RosbagReader::associateImages() {

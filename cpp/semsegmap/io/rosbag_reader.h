@@ -46,6 +46,13 @@ struct RosbagOptions {
 // key, a missing '=' or value, or a tolerance that is not a positive number.
 RosbagOptions parseRosbagOptions(const std::string& text);
 
+// The CameraInfo topic beside an image topic: ".../image_raw" and ".../image_raw/compressed"
+// both have theirs at ".../camera_info".
+std::string cameraInfoTopic(const std::string& image_topic);
+// A camera's name from its image topic: the namespace without its leading '/'
+// ("/kitti/camera_left/image_raw" -> "kitti/camera_left"), or the topic when it has none.
+std::string cameraNameOfTopic(const std::string& image_topic);
+
 class RosbagReader : public FrameSource {
  public:
   // Opens the bag and indexes it: the topics, each message's place and header stamp, the TF

@@ -60,6 +60,9 @@ class MappingSession {
                  std::shared_ptr<Describer> describer, const FrontEndStages& stages = {});
   void process(const Frame& frame);
   MappingRun finish();  // once, after the last frame
+  // The map of the segments finished so far, without those still in the local map (finish()
+  // adds them): what a robot mapping live saves on request (docs/ros.md).
+  TargetMap mapSoFar() const { return builder_.build(); }
   // The segments whose earlier observations the session holds until they finish
   // (target_map.earlier_observations_apart_m): each is still in the local map.
   std::vector<SegmentId> segmentsWithEarlierObservations() const;
