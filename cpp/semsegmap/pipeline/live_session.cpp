@@ -62,6 +62,13 @@ void LiveSession::addOdometry(const StampedPose& odometry) {
   enqueue(std::move(ready));
 }
 
+void LiveSession::addFrame(Frame frame) {
+  rethrow();
+  std::vector<Frame> one;
+  one.push_back(std::move(frame));
+  enqueue(std::move(one));
+}
+
 void LiveSession::enqueue(std::vector<Frame> frames) {
   for (Frame& frame : frames) {
     Clock::time_point arrival = Clock::now();

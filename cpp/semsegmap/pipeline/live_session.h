@@ -67,6 +67,10 @@ class LiveSession {
   void addPicture(size_t camera, PictureMessage picture);
   void addOdometry(const StampedPose& odometry);
 
+  // A frame already made (a recording's): queued after the frames made before it, without the
+  // assembly. What the offline commands feed (runMapping, runLocalization: never_drop).
+  void addFrame(Frame frame);
+
   std::vector<LivePose> poll();  // the poses found since the last call, in order
   // The end of the input: the waiting scans are made into frames with what they have, the queue
   // is worked off, the worker stops. The poses not yet polled stay for poll(). Once.

@@ -6,6 +6,7 @@
 
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/localize/registration_check.h"
+#include "semsegmap/pipeline/live_session.h"
 #include "semsegmap/pipeline/map_parameters.h"
 
 namespace semsegmap {
@@ -26,11 +27,22 @@ bool feedFrames(FrameSource& source, const RunOptions& options,
 
 namespace {
 
-// Feeds the run's frames (at most options.max_frames) to a mapping or localization session;
-// whether every frame was fed.
+// Feeds the run's frames (at most options.max_frames) to a mapping or localization session
+// through the live core (live_session.h), as a robot's would be, but never dropping: the session
+// works on one frame on the live session's worker while the next is read and decoded, in order,
+// so a recording gives what it gave frame by frame. Whether every frame was fed.
 template <typename Session>
 bool feed(FrameSource& source, const RunOptions& options, Session& session) {
-  return feedFrames(source, options, [&session](const Frame& frame) { session.process(frame); });
+  LiveConfig config;
+  config.never_drop = true;
+  LiveSession live(config, [&session](const Frame& frame) {
+    session.process(frame);
+    return std::vector<LivePose>{};
+  });
+  const bool whole =
+      feedFrames(source, options, [&live](const Frame& frame) { live.addFrame(frame); });
+  live.finish();
+  return whole;
 }
 
 // The describer is checked before any of it is read: a constructor's arguments are evaluated in
