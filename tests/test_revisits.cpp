@@ -298,6 +298,17 @@ NamedConfig variant(NamedConfig config, const std::string& name, Change change) 
   return config;
 }
 
+// The first frames of the wake-ups at a revisit localized by their first scan; none may be
+// wrong first.
+std::vector<size_t> fromOneScan(const RevisitResult& r) {
+  std::vector<size_t> frames;
+  for (const WakeUp& w : r.wake_ups) {
+    EXPECT_FALSE(w.wrong_first) << r.config << " frame " << w.frames.first;
+    if (w.revisit && w.localized == 1) frames.push_back(w.frames.first);
+  }
+  return frames;
+}
+
 // The real KITTI 00 scans: map from the 24 scans up to frame 276, localize the 12 of 1503-1759,
 // three of which (1576, 1615, 1634) pass within 1.5 m of mapped scans. The scans lie 10-40 m
 // apart: 1576 localizes only from its own segments (localization.latest_scan_fallback_m), as its
@@ -398,14 +409,6 @@ TEST(RevisitExperiment, RealKittiWakeUpLocalizesFromOneScanWithEarlierObservatio
   const RevisitResult& with = e.results[0];
   const RevisitResult& without = e.results[1];
   EXPECT_GT(with.map_segments, without.map_segments);
-  const auto fromOneScan = [](const RevisitResult& r) {
-    std::vector<size_t> frames;
-    for (const WakeUp& w : r.wake_ups) {
-      EXPECT_FALSE(w.wrong_first) << r.config << " frame " << w.frames.first;
-      if (w.revisit && w.localized == 1) frames.push_back(w.frames.first);
-    }
-    return frames;
-  };
   EXPECT_EQ(fromOneScan(with), (std::vector<size_t>{27, 29})) << "1576 and 1634";
   EXPECT_LT(fromOneScan(without).size(), 2u);
   for (const RevisitLocalization& l : with.localizations) {
@@ -441,14 +444,6 @@ TEST(RevisitExperiment, RealKittiWakeUpsAreAllRelocalizedFromTheirOneScan) {
                  })};
   const RevisitExperiment e = evaluateRevisits(*source, cfg, tmp.path());
   ASSERT_EQ(e.results.size(), 2u);
-  const auto fromOneScan = [](const RevisitResult& r) {
-    std::vector<size_t> frames;
-    for (const WakeUp& w : r.wake_ups) {
-      EXPECT_FALSE(w.wrong_first) << r.config << " frame " << w.frames.first;
-      if (w.revisit && w.localized == 1) frames.push_back(w.frames.first);
-    }
-    return frames;
-  };
   EXPECT_EQ(fromOneScan(e.results[0]), (std::vector<size_t>{27, 28, 29})) << "1576, 1615, 1634";
   EXPECT_EQ(e.results[0].wrong, 0u);
   // Within 0.3 m of the registered ground truth, and 2 degrees: 1576's reference is itself
