@@ -193,10 +193,43 @@ std::vector<std::pair<std::string, std::string>> helpOptions(const std::string& 
 }
 
 // `semsegmap COMMAND --help`, run once per command (each start of the binary takes a second).
+// `semsegmap COMMAND --help`, kept in a folder named after this binary's path and time, so that
+// the several tests that read every command's help (each its own process) start the binary once
+// a command between them: starting it (libtorch and its libraries) takes about a second of CPU.
+// A rebuilt binary has another time, hence another folder. Written under a temporary name and
+// renamed, so that tests running side by side never read half a file.
+Result helpOnDisk(const std::string& command) {
+  const auto stamp = std::filesystem::last_write_time(g_binary).time_since_epoch().count();
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("semsegmap_help_" + std::to_string(std::hash<std::string>{}(g_binary)) + "_" +
+       std::to_string(stamp));
+  std::string name = command;
+  std::replace(name.begin(), name.end(), ' ', '_');
+  const std::filesystem::path file = dir / name;
+  if (std::ifstream in{file}) {
+    Result r;
+    in >> r.code;
+    in.ignore();
+    std::string out_size;
+    std::getline(in, out_size);
+    const std::string rest{std::istreambuf_iterator<char>(in), {}};
+    r.out = rest.substr(0, std::stoul(out_size));
+    r.err = rest.substr(r.out.size());
+    return r;
+  }
+  Result r = run(command + " --help");
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path part = file.string() + "." + std::to_string(::getpid());
+  std::ofstream(part) << r.code << "\n" << r.out.size() << "\n" << r.out << r.err;
+  std::filesystem::rename(part, file);
+  return r;
+}
+
 const Result& help(const std::string& command) {
   static std::map<std::string, Result> cache;
   auto it = cache.find(command);
-  if (it == cache.end()) it = cache.emplace(command, run(command + " --help")).first;
+  if (it == cache.end()) it = cache.emplace(command, helpOnDisk(command)).first;
   return it->second;
 }
 

@@ -15,7 +15,7 @@ namespace semsegmap {
 
 namespace {
 
-constexpr std::string_view kMagic("SSMMAP\r\n", 8);
+constexpr std::string_view kMapMagic("SSMMAP\r\n", 8);
 constexpr uint32_t kFlagFloat16 = 1u << 0;
 constexpr uint32_t kFlagPoints = 1u << 1;
 constexpr uint32_t kFlagScanContexts = 1u << 2;
@@ -140,7 +140,7 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
   bool points = false;
   for (const MapSegment& s : map.segments) points = points || !s.points.empty();
   BinaryWriter w;
-  w.putBytes(kMagic.data(), kMagic.size());
+  w.putBytes(kMapMagic.data(), kMapMagic.size());
   w.put<uint32_t>(kMapFormatVersion);
   const bool scan_contexts = map.scan_contexts.size() > 0;
   w.put<uint32_t>((options.float16 ? kFlagFloat16 : 0u) | (points ? kFlagPoints : 0u) |
@@ -180,7 +180,7 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
 TargetMap loadTargetMap(const std::filesystem::path& path) {
   const std::string bytes = readFileBytes(path);
   BinaryReader r(path, bytes, "map file");
-  r.expectMagic(kMagic);
+  r.expectMagic(kMapMagic);
   const uint32_t version = r.get<uint32_t>("the header");
   if (version == 1)
     r.fail("map format version 1 records no build settings, this build reads version " +

@@ -15,7 +15,7 @@ namespace semsegmap {
 
 namespace {
 
-constexpr std::string_view kMagic("SSMNET", 6);
+constexpr std::string_view kModelMagic("SSMNET", 6);
 
 void putConfig(BinaryWriter& w, const NetConfig& c) {
   for (const int32_t f : {c.descriptor_dim, c.num_points, c.num_classes, c.grid_xy, c.grid_z,
@@ -100,7 +100,7 @@ ModelTensor getTensor(BinaryReader& r, const TensorShape& expected) {
 
 void writeModelFile(const std::filesystem::path& path, const Model& model) {
   BinaryWriter w;
-  w.putBytes(kMagic.data(), kMagic.size());
+  w.putBytes(kModelMagic.data(), kModelMagic.size());
   w.put(kModelFormatVersion);
   w.putString32(descriptorName(model.config.kind));
   putConfig(w, model.config);
@@ -123,7 +123,7 @@ Model readModelFile(const std::filesystem::path& path, std::optional<DescriptorK
     throw std::runtime_error(path.string() + ": cannot open model file (missing or not a file)");
   const std::string bytes = readFileBytes(path);
   BinaryReader r(path, bytes, "model file");
-  r.expectMagic(kMagic);
+  r.expectMagic(kModelMagic);
   const uint32_t version = r.get<uint32_t>("the header");
   if (version < 1 || version > kModelFormatVersion)
     r.fail("model format version " + std::to_string(version) + ", this build reads versions 1.." +

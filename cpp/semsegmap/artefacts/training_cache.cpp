@@ -18,7 +18,7 @@ namespace semsegmap {
 
 namespace {
 
-constexpr std::string_view kMagic("SSMTRAIN", 8);
+constexpr std::string_view kCacheMagic("SSMTRAIN", 8);
 // 3: the checksum covers the whole file (core/binary_io.h), as in the other formats.
 // 4: a point's byte holds whether it has a class besides whether it has colour (unobserved
 // points); a cache of another version is extracted again.
@@ -68,7 +68,7 @@ TrainingObservation getObservation(BinaryReader& r, size_t sources) {
 void writeTrainingCache(const std::filesystem::path& path, const TrainingSet& set,
                         const std::string& provenance) {
   BinaryWriter w;
-  w.putBytes(kMagic.data(), kMagic.size());
+  w.putBytes(kCacheMagic.data(), kCacheMagic.size());
   w.put(kVersion);
   w.putString32(provenance);
   w.put(static_cast<uint32_t>(set.sources.size()));
@@ -88,7 +88,7 @@ std::optional<TrainingSet> readTrainingCache(const std::filesystem::path& path,
   if (!std::filesystem::exists(path, error)) return std::nullopt;
   const std::string bytes = readFileBytes(path);
   BinaryReader r(path, bytes, "training cache");
-  r.expectMagic(kMagic);
+  r.expectMagic(kCacheMagic);
   // An older layout is not an error: the data is simply extracted again.
   if (r.get<uint32_t>("the header") != kVersion) return std::nullopt;
   r.checksummed();

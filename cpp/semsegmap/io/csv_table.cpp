@@ -8,9 +8,7 @@
 
 namespace semsegmap {
 
-namespace {
-
-std::vector<std::string> splitFields(const std::string& line) {
+std::vector<std::string> splitCsvFields(const std::string& line) {
   std::vector<std::string> fields(1);
   for (const char c : line) {
     if (c == ',')
@@ -20,6 +18,8 @@ std::vector<std::string> splitFields(const std::string& line) {
   }
   return fields;
 }
+
+namespace {
 
 std::string joined(const std::vector<std::string>& fields) {
   std::string s;
@@ -39,7 +39,7 @@ CsvTable CsvTable::read(const std::filesystem::path& path) {
   while (std::getline(in, line)) {
     ++number;
     if (line.empty() || line == "\r") continue;
-    std::vector<std::string> fields = splitFields(line);
+    std::vector<std::string> fields = splitCsvFields(line);
     if (t.header_.empty()) {
       t.header_ = std::move(fields);
       continue;

@@ -11,6 +11,9 @@
 
 namespace semsegmap {
 
+// One line's comma-separated fields (no quoting; a trailing '\r' of a Windows editor dropped).
+std::vector<std::string> splitCsvFields(const std::string& line);
+
 class CsvTable {
  public:
   // Throws std::runtime_error "<path>: cannot open", "<path>: empty (no header line)" or

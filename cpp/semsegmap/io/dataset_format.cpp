@@ -27,6 +27,10 @@ const char* const kFramesCsvHeader =
     "index,timestamp_s,odom_x,odom_y,odom_z,odom_qx,odom_qy,odom_qz,odom_qw,"
     "gt_x,gt_y,gt_z,gt_qx,gt_qy,gt_qz,gt_qw";
 
+std::string imageSizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
 std::string frameFileName(size_t index, const std::string& extension) {
   char digits[32];
   std::snprintf(digits, sizeof(digits), "%06zu", index);
@@ -77,8 +81,6 @@ void emitPose(YAML::Emitter& out, const fs::path& path, const char* field, const
   out << YAML::EndSeq;
 }
 
-constexpr long long kMaxInt = std::numeric_limits<int>::max();
-
 // Only T_base_lidar is required: the beam pattern, ranges and noise describe the simulated
 // sensor and are kept for the simulator and the contact sheet; a real recording leaves them
 // out and gets the defaults, which nothing downstream of the scans reads.
@@ -102,8 +104,10 @@ Camera parseCamera(const YamlFields& p, const YAML::Node& node, const std::strin
   Camera cam;
   cam.name = p.text(node, w, "name");
   // Sizes are range-checked by SensorRig::validate(), which says what is expected.
-  cam.width = static_cast<int>(p.integer(node, w, "width", -kMaxInt, kMaxInt));
-  cam.height = static_cast<int>(p.integer(node, w, "height", -kMaxInt, kMaxInt));
+  cam.width =
+      static_cast<int>(p.integer(node, w, "width", -YamlFields::kMaxInt, YamlFields::kMaxInt));
+  cam.height =
+      static_cast<int>(p.integer(node, w, "height", -YamlFields::kMaxInt, YamlFields::kMaxInt));
   cam.fx = p.number(node, w, "fx");
   cam.fy = p.number(node, w, "fy");
   cam.cx = p.number(node, w, "cx");

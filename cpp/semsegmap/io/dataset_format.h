@@ -33,6 +33,9 @@ void checkLabelClasses(const std::filesystem::path& path, const Image& label_ima
 void writeMetaYaml(const std::filesystem::path& path, const DatasetInfo& info);
 DatasetInfo readMetaYaml(const std::filesystem::path& path);
 
+// "640x480": an image size in the errors of the reader and the writer.
+std::string imageSizeText(int width, int height);
+
 // LiDAR scan as float32 x y z intensity (KITTI .bin layout).
 void writeLidarBin(const std::filesystem::path& path, const std::vector<LidarPoint>& points);
 std::vector<LidarPoint> readLidarBin(const std::filesystem::path& path);

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/io/csv_table.h"
 #include "semsegmap/io/dataset_format.h"
 #include "semsegmap/io/image_io.h"
 
@@ -31,17 +32,6 @@ constexpr uint64_t kMinPngBytes = 8 + 25 + 12;
 
 void requireFile(const fs::path& path) {
   if (!fs::exists(path)) throw std::runtime_error(path.string() + ": missing");
-}
-
-std::vector<std::string> splitFields(const std::string& line) {
-  std::vector<std::string> fields(1);
-  for (char c : line) {
-    if (c == ',')
-      fields.emplace_back();
-    else
-      fields.back() += c;
-  }
-  return fields;
 }
 
 // Parses frames.csv rows with messages "<path>: line N: <column>: <what was wrong>".
@@ -90,10 +80,6 @@ class CsvRowParser {
   const std::vector<std::string>& columns_;
 };
 
-std::string sizeText(int width, int height) {
-  return std::to_string(width) + "x" + std::to_string(height);
-}
-
 // The size of a frame's file by stat, without reading it; throws "<path>: missing".
 uint64_t fileSize(const fs::path& path) {
   struct stat st {};
@@ -129,8 +115,9 @@ Image readCameraPng(const fs::path& path, const Camera& cam, int channels) {
                              " channels, expected " + std::to_string(channels) +
                              (channels == 1 ? " (class ids)" : " (RGB)"));
   if (image.width != cam.width || image.height != cam.height)
-    throw std::runtime_error(path.string() + ": image is " + sizeText(image.width, image.height) +
-                             ", meta.yaml says " + sizeText(cam.width, cam.height));
+    throw std::runtime_error(path.string() + ": image is " +
+                             imageSizeText(image.width, image.height) + ", meta.yaml says " +
+                             imageSizeText(cam.width, cam.height));
   return image;
 }
 
@@ -207,7 +194,7 @@ bool DatasetReader::readLine(std::string& line, uint64_t& bytes, size_t line_num
 // Throws what is wrong with a row the index pass refused: its field count or its index.
 [[noreturn]] void DatasetReader::rowError(const std::string& line, size_t line_number,
                                           bool have_previous, size_t previous) const {
-  static const std::vector<std::string> columns = splitFields(kFramesCsvHeader);
+  static const std::vector<std::string> columns = splitCsvFields(kFramesCsvHeader);
   const CsvRowParser p(csv_, line_number, columns);
   const size_t fields = static_cast<size_t>(std::count(line.begin(), line.end(), ',')) + 1;
   if (fields != kCsvFields)
@@ -256,9 +243,9 @@ void DatasetReader::index(size_t frames_to_check) {
 }
 
 DatasetReader::Row DatasetReader::parse(const std::string& line, size_t line_number) const {
-  static const std::vector<std::string> columns = splitFields(kFramesCsvHeader);
+  static const std::vector<std::string> columns = splitCsvFields(kFramesCsvHeader);
   const CsvRowParser p(csv_, line_number, columns);
-  const std::vector<std::string> fields = splitFields(line);
+  const std::vector<std::string> fields = splitCsvFields(line);
   if (fields.size() != kCsvFields)
     p.fail("expected " + std::to_string(kCsvFields) + " comma-separated fields, got " +
            std::to_string(fields.size()));

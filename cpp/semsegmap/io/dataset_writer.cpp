@@ -65,10 +65,6 @@ fs::path cameraDir(const fs::path& dir, size_t k, bool label) {
   return dir / ("cam" + std::to_string(k) + (label ? "_label" : ""));
 }
 
-std::string sizeText(int width, int height) {
-  return std::to_string(width) + "x" + std::to_string(height);
-}
-
 void checkImage(const fs::path& path, const Image& image, const Camera& cam, const char* kind,
                 int channels) {
   if (image.channels != channels)
@@ -77,8 +73,8 @@ void checkImage(const fs::path& path, const Image& image, const Camera& cam, con
                                 std::to_string(channels));
   if (image.width != cam.width || image.height != cam.height)
     throw std::invalid_argument(path.string() + ": " + kind + " image of camera '" + cam.name +
-                                "' is " + sizeText(image.width, image.height) +
-                                ", meta.yaml says " + sizeText(cam.width, cam.height));
+                                "' is " + imageSizeText(image.width, image.height) +
+                                ", meta.yaml says " + imageSizeText(cam.width, cam.height));
   if (image.data.size() != static_cast<size_t>(image.width) * image.height * image.channels)
     throw std::invalid_argument(path.string() + ": " + kind + " image of camera '" + cam.name +
                                 "' holds " + std::to_string(image.data.size()) +

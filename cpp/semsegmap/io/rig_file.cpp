@@ -9,8 +9,6 @@ namespace semsegmap {
 
 namespace {
 
-constexpr long long kMaxInt = std::numeric_limits<int>::max();
-
 // A list of numbers, flat or as rows: [[a, b], [c, d]] and [a, b, c, d] both give a b c d.
 std::vector<double> flatNumbers(const YamlFields& p, const YAML::Node& node,
                                 const std::string& name) {
@@ -166,7 +164,7 @@ RigFile readRigFile(const std::filesystem::path& path) {
   const YamlFields p(path);
   const YAML::Node root = loadYamlFile(path);
   p.checkKeys(root, "", {"rig_format_version", "name", "rate_hz", "lidar", "cameras"});
-  const long long version = p.integer(root, "", "rig_format_version", 0, kMaxInt);
+  const long long version = p.integer(root, "", "rig_format_version", 0, YamlFields::kMaxInt);
   if (version != 1)
     p.fail("rig_format_version is " + std::to_string(version) + ", this build reads version 1");
   RigFile rig;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -54,6 +55,9 @@ class YamlFields {
   double number(const YAML::Node& map, const std::string& where, const char* key) const {
     return toNumber(child(map, where, key), field(where, key));
   }
+
+  // The bound of a field read into an int.
+  static constexpr long long kMaxInt = std::numeric_limits<int>::max();
 
   long long integer(const YAML::Node& map, const std::string& where, const char* key, long long lo,
                     long long hi) const {

@@ -11,8 +11,6 @@
 
 namespace semsegmap {
 
-namespace {}  // namespace
-
 // Between frames only: a frame the session started is finished, so what it holds stays whole.
 bool feedFrames(FrameSource& source, const RunOptions& options,
                 const std::function<void(const Frame&)>& process) {
