@@ -58,8 +58,13 @@ struct RelocalizationConfig {
   int k_in_place = 8;
   double place_radius_m = 60.0;  // a place: the map segments this near its centre
   double cell_m = 10.0;          // places are centred on a grid of this spacing (x, y)
-  size_t max_places = 10;        // places verified, best voted first
-  size_t min_votes = 4;          // a place fewer local segments voted for is not verified
+  // Places verified, best voted first. Near the map's edge a place's disc holds fewer map
+  // segments, so the right place gathers fewer votes than look-alikes inside the map: with 10,
+  // two HDL-64E wake-ups at the edge of S1's map were found only a few frames later (ranked
+  // 11th-20th at their first scan). A wrong place costs about a millisecond: the registration
+  // check refuses it on a sample of its points.
+  size_t max_places = 20;
+  size_t min_votes = 4;  // a place fewer local segments voted for is not verified
   GeometricVerificationConfig verification = relocalizationVerification();
   RegistrationCheckConfig check;
   // The map's nearest scan context, when the map holds them, proposes a pose too when it is
