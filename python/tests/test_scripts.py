@@ -129,6 +129,17 @@ def test_memory_table_gives_the_growth_after_the_first_kilometre(tmp_path):
     assert rows[2] == "| long | 300 | 400 | 410 | 410 (2.1 km) | +5.0 % |"
 
 
+def test_memory_table_of_a_long_run_shows_every_few_kilometres(tmp_path):
+    rss = tmp_path / "rss.csv"
+    rss.write_text("phase,frame,distance_m,rss_mb\n" + "".join(
+        f"localize,{k},{k * 500},{400 + k}\n" for k in range(38)))  # 18.5 km
+    rows = write_table(tmp_path, "memory", [f"long={rss}"])
+    assert rows[0] == ("| run | 0 km | 1 km | 2 km | 4 km | 6 km | 8 km | 10 km | 12 km | 14 km "
+                       "| 16 km | 18 km | at the end | growth after 1 km |")
+    assert rows[2] == ("| long | 400 | 402 | 404 | 408 | 412 | 416 | 420 | 424 | 428 | 432 | 436 "
+                       "| 437 (18.5 km) | +8.7 % |")
+
+
 def test_slam_table_shows_an_unknown_error_as_a_dash(tmp_path):
     summary = tmp_path / "summary.json"
     summary.write_text(json.dumps({"frames": 9, "loop_closures": 3, "ate_odometry": None,
