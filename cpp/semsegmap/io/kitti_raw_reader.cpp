@@ -191,10 +191,9 @@ Frame KittiRawReader::frame(size_t index) {
     throw std::runtime_error(files.image.string() + ": expected a 3-channel color image, found " +
                              std::to_string(rgb.channels) + " channel(s)");
   if (rgb.width != cam.width || rgb.height != cam.height)
-    throw std::runtime_error(files.image.string() + ": image is " + std::to_string(rgb.width) +
-                             "x" + std::to_string(rgb.height) + " but " +
-                             cam_to_cam_path_.string() + ": S_rect_02 says " +
-                             std::to_string(cam.width) + "x" + std::to_string(cam.height));
+    throw std::runtime_error(
+        files.image.string() + ": image is " + imageSizeText(rgb.width, rgb.height) + " but " +
+        cam_to_cam_path_.string() + ": S_rect_02 says " + imageSizeText(cam.width, cam.height));
   f.cameras.push_back(CameraFrame{std::move(rgb), Image()});
 
   if (has_oxts_) {

@@ -54,10 +54,6 @@ const std::vector<SemanticKittiClass>& semanticKittiClasses() {
 
 namespace {
 
-std::string sizeText(const Image& im) {
-  return std::to_string(im.width) + "x" + std::to_string(im.height);
-}
-
 // image_2's camera: P2's pinhole after Tr, sized by the first picture (calib.txt has no size).
 Camera image2Camera(const KittiCalibFile& calib, const fs::path& first_picture) {
   const Image first = readColorImage(first_picture);
@@ -181,9 +177,10 @@ Frame SemanticKittiReader::frame(size_t index) {
     Image rgb = readColorImage(files.image);
     const Camera& cam = info_.rig.cameras.front();
     if (rgb.width != cam.width || rgb.height != cam.height)
-      throw std::runtime_error(files.image.string() + ": picture is " + sizeText(rgb) + " but " +
-                               size_image_.string() + " is " + std::to_string(cam.width) + "x" +
-                               std::to_string(cam.height) + " (image_2 has one size)");
+      throw std::runtime_error(files.image.string() + ": picture is " +
+                               imageSizeText(rgb.width, rgb.height) + " but " +
+                               size_image_.string() + " is " +
+                               imageSizeText(cam.width, cam.height) + " (image_2 has one size)");
     f.cameras.push_back(CameraFrame{std::move(rgb), Image()});
   }
   if (files.T_world_lidar) {
