@@ -364,6 +364,28 @@ TEST(Modes, EarlierObservationsAreHeldOnlyForSegmentsStillInTheLocalMap) {
   EXPECT_GT(session.finish().earlier_observations, 0u);
 }
 
+// The local segments a localization queries are exactly the segmenter's reported ones: absorbed,
+// finished and dropped segments leave at once. A dropped one left behind stayed in every query
+// to the end of the run, and a long run's queries (and their geometric check) grew without bound.
+TEST(Modes, LocalSegmentsAreTheSegmentsStillReported) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  PipelineConfig config = semsegmapConfig();
+  config.segmentation.max_segment_points = 1500;  // some are dropped as too large
+  auto source = openDataset("sim:world=1,run=S2,preset=tiny,frames=120");
+  Pipeline pipeline(config, source->info(), PoseSource::kGroundTruth,
+                    std::make_shared<OracleDescriber>());
+  size_t dropped = 0, stale = 0;
+  for (size_t i = 0; i < source->size(); ++i) {
+    dropped += pipeline.process(source->frame(i)).segmentation.dropped.size();
+    std::vector<SegmentId> reported;
+    for (const Segment* s : pipeline.segmenter().activeSegments()) reported.push_back(s->id);
+    for (const SegmentId id : pipeline.localSegmentQuery().ids)
+      stale += !std::binary_search(reported.begin(), reported.end(), id);
+  }
+  EXPECT_GT(dropped, 0u) << "the run must drop a described segment for this to test anything";
+  EXPECT_EQ(stale, 0u) << "query entries for segments no longer reported";
+}
+
 // A run that localized nothing has no mean error: null, never a 0 that reads as perfect.
 TEST(Modes, SummaryOfARunWithoutLocalizationsHasNoMeanError) {
   LocalizationRun run;

@@ -218,6 +218,35 @@ TEST(IncrementalSegmenter, ObservationsSizesAndFinishing) {
   EXPECT_TRUE(run.seg.activeSegments().empty());
 }
 
+// A reported segment that grows past the maximum is said dropped once, so that whoever kept it
+// (the local segments a localization queries) lets it go; so is one that absorbs a dropped one.
+TEST(IncrementalSegmenter, AReportedSegmentThatBecomesTooLargeIsReportedDroppedOnce) {
+  SegmentationConfig c;
+  c.min_segment_points = 20;
+  c.max_segment_points = 400;
+  SegRun run(c);
+  const auto first = run.add(wall(10.05f, 10, 10, cls::kBuilding, 0.3f));
+  ASSERT_EQ(first.observed.size(), 1u);
+  const SegmentId grown = first.observed[0];
+  EXPECT_TRUE(first.dropped.empty());
+  const auto past = run.add(wall(10.05f, 25, 20, cls::kBuilding, 0.3f));
+  EXPECT_EQ(past.dropped, std::vector<SegmentId>{grown});
+  EXPECT_TRUE(past.observed.empty());
+  EXPECT_TRUE(run.seg.activeSegments().empty());
+  EXPECT_TRUE(run.add(wall(10.05f, 30, 20, cls::kBuilding, 0.3f)).dropped.empty()) << "once";
+
+  // A reported segment absorbs one that was too large from its first step (never reported):
+  // the oldest id survives, dropped, and is said so.
+  const auto small = run.add(wall(30.05f, 5, 5, cls::kVegetation, 0.6f, -1.0f));
+  ASSERT_EQ(small.observed.size(), 1u);
+  const SegmentId older = small.observed[0];
+  EXPECT_TRUE(run.add(wall(30.05f, 25, 20, cls::kVegetation, 0.6f)).dropped.empty());
+  const auto bridged = run.add(wall(30.05f, 5, 5, cls::kVegetation, 0.6f, -0.5f));
+  ASSERT_EQ(bridged.merges.size(), 1u);
+  EXPECT_EQ(bridged.merges[0].survivor, older);
+  EXPECT_EQ(bridged.dropped, std::vector<SegmentId>{older});
+}
+
 TEST(PipelineConfig, ShippedConfigsParse) {
   const PipelineConfig sem =
       loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap.yaml");

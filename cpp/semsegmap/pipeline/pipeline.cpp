@@ -176,7 +176,10 @@ FrameResult Pipeline::process(const Frame& given) {
   // Only segments whose observation changed are described again: most of the local map is the
   // same from one frame to the next.
   t0 = std::chrono::steady_clock::now();
+  // Absorbed and dropped segments leave the local segments at once: a stale entry would stay in
+  // every localization query until the run ends (a long run's queries grew without bound).
   for (const SegmentMerge& m : r.segmentation.merges) described_.erase(m.absorbed);
+  for (SegmentId id : r.segmentation.dropped) described_.erase(id);
   describe(r.segmentation.observed, frame.index);
   r.described = r.segmentation.observed.size();
   for (const Segment& s : r.segmentation.finished) {

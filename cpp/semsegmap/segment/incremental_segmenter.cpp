@@ -165,10 +165,11 @@ void IncrementalSegmenter::observeChanged(const std::vector<SegmentId>& changed,
   for (SegmentId id : changed) {
     SegmentState& st = segments_.at(id);
     st.segment.last_frame = frame_index;
-    if (st.dropped) continue;
-    if (st.live > config_.max_segment_points) {
+    if (st.dropped || st.live > config_.max_segment_points) {
       // Too large to be a useful landmark (ground remnants, long walls): dropped for good, and
-      // whatever grows into it later is dropped with it.
+      // whatever grows into it later is dropped with it (absorb() passes it on). Reported once,
+      // when it loses its observations.
+      if (!st.segment.observations.empty()) out.dropped.push_back(id);
       st.dropped = true;
       st.segment.observations.clear();
       continue;

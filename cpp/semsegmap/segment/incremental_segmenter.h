@@ -23,6 +23,9 @@ struct SegmentationUpdate {
   std::vector<SegmentId> observed;  // segments that got a new observation this step
   std::vector<SegmentMerge> merges;
   std::vector<Segment> finished;  // left the local map; their last observation is final
+  // Reported before, now too large to be a landmark: never finished, so whoever kept them
+  // (the local segments' descriptors) lets them go here.
+  std::vector<SegmentId> dropped;
 };
 
 class IncrementalSegmenter {
