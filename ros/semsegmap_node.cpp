@@ -169,6 +169,7 @@ class Node {
     if (!mapping()) {
       session_ = std::make_unique<LocalizationSession>(config_, info, map_, describer_,
                                                        MapSettingsCheck::kRefuse, stages);
+      session_->keepHistory(false);  // poses are published, not kept: days of them would pile up
       return localizingProcess(*session_);
     }
     mapping_ =

@@ -303,6 +303,7 @@ TEST(LiveSession, LocalizesAsTheOfflineRunFromTheSameMessages) {
 
   auto source = openDataset(query);
   LocalizationSession session(config, source->info(), map, describer);
+  session.keepHistory(false);  // as the node: the poses go out, the session keeps the latest
   LiveConfig c;
   c.assembly.cameras = source->info().rig.cameras.size();
   c.never_drop = true;
@@ -329,6 +330,15 @@ TEST(LiveSession, LocalizesAsTheOfflineRunFromTheSameMessages) {
   }
   EXPECT_EQ(live.stats().dropped, 0u);
   EXPECT_EQ(live.stats().assembly.missing_pictures, 0u);
+  // No history: the latest frame and localization alone; the counts and the distance cover the
+  // run.
+  const LocalizationRun& kept = session.run();
+  EXPECT_EQ(kept.trajectory_odom.size(), 1u);
+  EXPECT_EQ(kept.frames.size(), 1u);
+  ASSERT_EQ(kept.localizations.size(), 1u);
+  EXPECT_EQ(kept.localizations[0].frame_index, offline.localizations.back().frame_index);
+  EXPECT_EQ(kept.stats.frames, offline.stats.frames);
+  EXPECT_NEAR(kept.distance_m, offline.distance_m, 1e-9);
 }
 
 }  // namespace

@@ -22,7 +22,9 @@ struct LiveLocalizer {
                 std::shared_ptr<const TargetMap> map, std::shared_ptr<Describer> d,
                 MapSettingsCheck check, const FrontEndStages& stages, const LiveConfig& live_config)
       : session(c, info, std::move(map), std::move(d), check, stages),
-        live(live_config, localizingProcess(session)) {}
+        live(live_config, localizingProcess(session)) {
+    session.keepHistory(false);  // a robot's poses go out through poll(), as the node's do
+  }
 };
 
 LiveConfig liveConfigOf(const DatasetInfo& info, bool odometry, size_t max_queued_frames,

@@ -491,13 +491,12 @@ void bindLocalization(py::module_& m) {
       .def(
           "process",
           [](LocalizationSession& s, const Frame& f) -> py::object {
-            const size_t before = s.run().localizations.size();
+            std::optional<LocalizationRecord> found;
             {
               py::gil_scoped_release release;
-              s.process(f);
+              found = s.process(f);
             }
-            if (s.run().localizations.size() == before) return py::none();
-            return py::cast(s.run().localizations.back());
+            return found ? py::cast(std::move(*found)) : py::none();
           },
           py::arg("frame"), "The LocalizationRecord this frame gave, or None")
       .def(

@@ -173,17 +173,14 @@ LiveStats LiveSession::stats() const {
 
 LiveSession::Process localizingProcess(LocalizationSession& session) {
   return [&session](const Frame& frame) {
-    const size_t before = session.run().localizations.size();
-    session.process(frame);
-    const LocalizationRun& run = session.run();
+    std::optional<LocalizationRecord> found = session.process(frame);
     std::vector<LivePose> out;
-    for (size_t i = before; i < run.localizations.size(); ++i) {
-      LivePose p;
-      p.record = run.localizations[i];
-      p.T_odom_base = run.trajectory_odom.back();
-      p.T_map_odom = p.record.T_map_base * p.T_odom_base.inverse();
-      out.push_back(std::move(p));
-    }
+    if (!found) return out;
+    LivePose p;
+    p.record = std::move(*found);
+    p.T_odom_base = session.run().trajectory_odom.back();
+    p.T_map_odom = p.record.T_map_base * p.T_odom_base.inverse();
+    out.push_back(std::move(p));
     return out;
   };
 }

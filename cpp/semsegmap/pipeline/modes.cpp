@@ -130,6 +130,7 @@ void MappingSession::keepEarlierObservations(const FrameResult& r) {
     for (KeptObservation& k : absorbed.mapped().kept) keep(survivor.kept, std::move(k));
     keep(survivor.kept, std::move(absorbed.mapped().latest));
   }
+  for (SegmentId id : r.segmentation.dropped) earlier_.erase(id);  // never goes into the map
   const auto& described = pipeline_.localSegments();
   for (SegmentId id : r.segmentation.observed) {
     const auto it = described.find(id);
@@ -252,7 +253,24 @@ LocalizationSession::LocalizationSession(const PipelineConfig& config, const Dat
   run_.odometry_is_ground_truth = info_.odometry_is_ground_truth;
 }
 
-void LocalizationSession::process(const Frame& frame) {
+// Without history, each list keeps its last entry: the latest frame's poses and stamp (the
+// distance moved is measured from its odometry pose) and the latest localization.
+namespace {
+template <typename T>
+void keepLast(std::vector<T>& v) {
+  if (v.size() > 1) v.erase(v.begin(), v.end() - 1);
+}
+}  // namespace
+
+void LocalizationSession::forgetHistory() {
+  keepLast(run_.localizations);
+  keepLast(run_.frames);
+  keepLast(run_.trajectory_gt);
+  keepLast(run_.trajectory_odom);
+}
+
+std::optional<LocalizationRecord> LocalizationSession::process(const Frame& frame) {
+  std::optional<LocalizationRecord> found;
   FrameResult r = pipeline_.process(frame);
   const double moved =
       run_.trajectory_odom.empty()
@@ -273,11 +291,14 @@ void LocalizationSession::process(const Frame& frame) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (o.attempt.found) {
       run_.localizations.push_back(recordOf(frame, o));
+      found = run_.localizations.back();
       localized_at_m_ = run_.distance_m;
     }
   }
   run_.stats.total += r.times;
   ++run_.stats.frames;
+  if (!keep_history_) forgetHistory();
+  return found;
 }
 
 // The local map's segments first; then, when the scan lies far from the one before, its own

@@ -146,7 +146,13 @@ class LocalizationSession {
                       std::shared_ptr<const TargetMap> map, std::shared_ptr<Describer> describer,
                       MapSettingsCheck settings = MapSettingsCheck::kRefuse,
                       const FrontEndStages& stages = {});
-  void process(const Frame& frame);
+  // The localization found on this frame, if any (also added to run().localizations).
+  std::optional<LocalizationRecord> process(const Frame& frame);
+  // A robot that localizes for days keeps no history: with `keep` false, run() holds only the
+  // latest frame's poses and stamp and the latest localization, beside the counts and the
+  // distance; a record lives on where the caller puts it (process() returns it). Offline runs keep
+  // everything (the default): their outputs are written from it.
+  void keepHistory(bool keep) { keep_history_ = keep; }
   // Where the robot is known to be (a GNSS fix, the last saved pose, a user's guess): a
   // relocalization then only searches the map within the prior's radius. Nothing: everywhere.
   void setPrior(std::optional<RelocalizationPrior> prior) { prior_ = std::move(prior); }
@@ -182,6 +188,7 @@ class LocalizationSession {
     Pose T_map_base = Pose::Identity();
   };
   // `relocalize`: try the relocalization path when the other paths find nothing.
+  void forgetHistory();
   Outcome localizeFrame(const Pipeline& pipeline, const Frame& frame, const Pose& T_local_base,
                         double moved, bool relocalize,
                         const std::optional<RelocalizationPrior>& prior) const;
@@ -196,6 +203,7 @@ class LocalizationSession {
   Pipeline pipeline_;
   LocalizationRun run_;
   size_t frames_ = 0;
+  bool keep_history_ = true;
   double localized_at_m_ = -1.0;  // run_.distance_m at the last localization; < 0: none yet
   std::optional<RelocalizationPrior> prior_;
 };
