@@ -215,6 +215,9 @@ void bindResults(py::module_& m) {
           },
           "(absorbed, survivor) id pairs")
       .def_property_readonly(
+          "dropped", [](const FrameResult& r) { return r.segmentation.dropped; },
+          "ids of the segments dropped as too large (max_segment_points) this frame")
+      .def_property_readonly(
           "finished", [](const FrameResult& r) { return r.segmentation.finished; },
           "the segments that left the local map (copies)")
       .def_property_readonly(

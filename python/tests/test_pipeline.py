@@ -45,6 +45,7 @@ def test_frame_results(processed):
     for x in results:
         assert x.finished_descriptors.shape[0] == len(x.finished)
         assert all(isinstance(a, int) and isinstance(b, int) for a, b in x.merges)
+        assert all(isinstance(i, int) for i in x.dropped)
 
 
 def test_timings(processed):
