@@ -297,7 +297,7 @@ def benchmarks_table(inputs):
 
 def memory_table(inputs):
     """The resident set while localizing, at each kilometre, and its growth after the first."""
-    rows, width = [], []
+    runs = []
     for label, path in labelled(inputs):
         try:
             with open(path, encoding="utf-8") as f:
@@ -307,20 +307,24 @@ def memory_table(inputs):
             fail(f"{path}: not an rss.csv of semsegmap_memory_run: {e}")
         if not samples or samples[-1][0] < 1:
             fail(f"{path}: localized less than 1 km, too short to measure growth")
-        # The first sample at or after each whole kilometre, as the run prints it; a run longer
-        # than 10 km every few kilometres (at most about ten columns), the first kept.
-        step = max(1, math.ceil(samples[-1][0] / 10))
-        kms = sorted({0, 1, *range(0, int(samples[-1][0]) + 1, step)})
-        at_km = [next(mb for km, mb in samples if km >= k) for k in kms]
-        largest = max(mb for km, mb in samples if km >= 1)
-        rows.append((label, at_km, samples[-1], 100 * (largest - at_km[1]) / at_km[1]))
-        if len(at_km) > len(width or []):
-            width = kms
-    header = ([("run", 0)] + [(f"{k} km", 1) for k in width] +
+        runs.append((label, samples))
+    # Whole kilometres, one set of columns for every run (the longest decides); beyond 10 km every
+    # few kilometres (at most about ten columns), the first kept.
+    longest = max(samples[-1][0] for _, samples in runs)
+    step = max(1, math.ceil(longest / 10))
+    kms = sorted({0, 1, *range(0, int(longest) + 1, step)})
+
+    def row(label, samples):
+        # The first sample at or after each kilometre, as the run prints it; blank past its end.
+        at_km = [next((f"{mb:.0f}" for km, mb in samples if km >= k), "") for k in kms]
+        at_1km = next(mb for km, mb in samples if km >= 1)
+        growth = 100 * (max(mb for km, mb in samples if km >= 1) - at_1km) / at_1km
+        last = samples[-1]
+        return [label, *at_km, f"{last[1]:.0f} ({last[0]:.1f} km)", f"{growth:+.1f} %"]
+
+    header = ([("run", 0)] + [(f"{k} km", 1) for k in kms] +
               [("at the end", 1), ("growth after 1 km", 1)])
-    return table(header, [[label, *[f"{mb:.0f}" for mb in at_km], *[""] * (len(width) - len(at_km)),
-                           f"{last[1]:.0f} ({last[0]:.1f} km)", f"{growth:+.1f} %"]
-                          for label, at_km, last, growth in rows])
+    return table(header, [row(label, samples) for label, samples in runs])
 
 
 def slam_table(inputs):
