@@ -16,6 +16,7 @@
 #include "semsegmap/pipeline/live_session.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/semantics/frame_labeler.h"
+#include "semsegmap/semantics/live_labeler.h"
 #include "semsegmap/settings/class_map_file.h"
 #include "semsegmap/settings/config.h"
 #include "semsegmap/sim/simulator.h"
@@ -51,19 +52,42 @@ Recorded s2Frames(const std::string& condition, uint64_t traffic) {
   return Recorded(std::move(frames), s.info());
 }
 
-// The MobileNet-class network of bench_semantics.cpp on every camera, through Cityscapes' map.
-std::unique_ptr<FrameLabeler> networkLabeler(int64_t rate_hz) {
-  if (rate_hz < 0) return nullptr;
+// The network of the second argument: -1 none; 0 or R > 0: the MobileNet-class network of
+// bench_semantics.cpp (seeded random weights) through Cityscapes' map on every picture, or at
+// R pictures a second per camera, in the scan loop; kShippedLive: the project's trained network
+// (models/semsegmap-seg.onnx) at its shipped budget on its own thread beside the scans, as on a
+// robot; kShippedEvery: the same network on every picture, in the scan loop.
+constexpr int64_t kShippedLive = 1000, kShippedEvery = 1001;
+
+std::unique_ptr<FrameLabeler> networkLabeler(int64_t code) {
+  if (code < 0) return nullptr;
+  const std::string source = SEMSEGMAP_SOURCE_DIR;
+  if (code >= kShippedLive) {
+    SemanticsConfig c = loadSemanticsConfig(source + "/config/semantics-sim-network.yaml");
+    auto network = std::make_shared<SegmentationNetwork>(
+        c, readFileBytes(c.model),
+        readClassMap(source + "/config/class_maps/semsegmap.yaml", ClassTable::Default()), c.model);
+    if (code == kShippedEvery) {
+      c.rate_hz = c.budget_cores = c.latency_s = 0;
+      return std::make_unique<ReplayLabeler>(c, networkFunction(network));
+    }
+    return std::make_unique<LiveLabeler>(network, Pose::Identity());
+  }
   SemanticsConfig c;
   c.model = std::string(SEMSEGMAP_ONNX_DIR) + "/mobilenet_seg.onnx";
-  c.rate_hz = static_cast<double>(rate_hz);
+  c.rate_hz = static_cast<double>(code);
   c.tolerance_s = 1.0;
   c.replace_dataset_labels = true;
-  const std::string maps = std::string(SEMSEGMAP_SOURCE_DIR) + "/config/class_maps";
   auto network = std::make_shared<SegmentationNetwork>(
-      c, readFileBytes(c.model), readClassMap(maps + "/cityscapes.yaml", ClassTable::Default()),
-      c.model);
-  return std::make_unique<FrameLabeler>(network);
+      c, readFileBytes(c.model),
+      readClassMap(source + "/config/class_maps/cityscapes.yaml", ClassTable::Default()), c.model);
+  return std::make_unique<ReplayLabeler>(network);
+}
+
+std::string networkText(int64_t code) {
+  if (code == kShippedLive) return " + the shipped network at its budget, beside the scans";
+  if (code == kShippedEvery) return " + the shipped network on every picture";
+  return " + network at " + std::to_string(code) + " Hz";
 }
 
 void BM_WholePipeline(benchmark::State& state) {
@@ -110,14 +134,19 @@ void BM_WholePipeline(benchmark::State& state) {
   }
   lap();
   state.SetLabel(name + " + " + config.descriptor.kind +
-                 (labeler ? " + network at " + std::to_string(state.range(1)) + " Hz" : ""));
+                 (labeler ? networkText(state.range(1)) : ""));
   const double n = static_cast<double>(std::max<size_t>(1, frames));
   state.counters["localized"] = static_cast<double>(localized) / n;
   state.counters["enrich_ms"] = total.enrich_ms / n;
   state.counters["map_seg_ms"] = (total.local_map_ms + total.segment_ms) / n;
   state.counters["describe_ms"] = total.describe_ms / n;
   state.counters["localize_ms"] = total.localize_ms / n;
-  if (labeler) state.counters["network_ms"] = labeler->stats().network_ms / n;
+  if (labeler) {
+    const LabelingStats l = labeler->stats();
+    state.counters["network_ms"] = l.network_ms / n;  // per scan
+    state.counters["network_share"] = l.share();
+    state.counters["unlabelled"] = static_cast<double>(l.unlabelled) / n;  // pictures per scan
+  }
   state.counters["Hz"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
 }
 // The front end alone (enrich, local map, segmentation; no describing or querying) on the
@@ -211,6 +240,9 @@ BENCHMARK(BM_WholePipeline)
     ->Args({1, -1})
     ->Args({0, 0})
     ->Args({0, 2})
+    ->Args({0, kShippedLive})
+    ->Args({1, kShippedLive})
+    ->Args({0, kShippedEvery})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(160);

@@ -39,4 +39,30 @@ BENCHMARK(BM_SegmentationNetwork)
     ->UseRealTime()
     ->MinTime(3.0);
 
+// The shipped network (models/semsegmap-seg.onnx, trained on the simulator) as
+// config/semantics-sim-network.yaml runs it: a 640x480 picture shrunk to 320x240, logits at
+// 160x120 upsampled back. Arg: OpenCV's threads.
+void BM_ShippedSegmentationNetwork(benchmark::State& state) {
+  SemanticsConfig config;
+  config.model = std::string(SEMSEGMAP_SOURCE_DIR) + "/models/semsegmap-seg.onnx";
+  config.input_width = 320;
+  config.input_height = 240;
+  config.threads = static_cast<int>(state.range(0));
+  SegmentationNetwork network(config, readFileBytes(config.model),
+                              ClassMap::Identity(ClassTable::Default()), config.model);
+  Image picture(640, 480, 3);
+  uint32_t seed = 7;
+  for (uint8_t& v : picture.data)
+    v = static_cast<uint8_t>((seed = seed * 1664525u + 1013904223u) >> 24);
+  network.check(640, 480);
+  for (auto _ : state) benchmark::DoNotOptimize(network.label(picture, "picture").data.data());
+  state.counters["Hz"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ShippedSegmentationNetwork)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+
 }  // namespace

@@ -10,6 +10,7 @@
 #include <topic_tools/shape_shifter.h>
 
 #include <csignal>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "node_rig.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
+#include "semsegmap/datasets/semantic_sources.h"
 #include "semsegmap/io/ros_decode.h"
 #include "semsegmap/io/rosbag_reader.h"
 #include "semsegmap/pipeline/input_modalities.h"
@@ -149,6 +151,7 @@ class Node {
     }
     DatasetInfo with = *info;
     with.has_odometry = !params_.odometry_topic.empty();
+    addSegmentationNetwork(with, stages);
     const DescriptorChoice choice = chooseDescriptor(config_.descriptor, inputModalitiesOf(with));
     if (!choice.note.empty()) ROS_INFO("semsegmap: %s", choice.note.c_str());
     describer_ = makeDescriber(choice.descriptor);
@@ -162,6 +165,21 @@ class Node {
   }
 
   bool mapping() const { return params_.mode == "map"; }
+
+  // The config's semantics: network labels the pictures that come without labels, on its own
+  // thread within its budget (semantics/live_labeler.h): a scan never waits for it. A shipped
+  // class map's name is looked up in class_maps/ beside the config, as in the source tree.
+  void addSegmentationNetwork(const DatasetInfo& info, FrontEndStages& stages) {
+    const SemanticsConfig semantics = loadSemanticsConfig(params_.config);
+    if (semantics.model.empty()) return;
+    const auto class_maps = std::filesystem::path(params_.config).parent_path() / "class_maps";
+    stages.network = loadSegmentationNetwork(semantics, info, class_maps);
+    stages.labelling = FrontEndStages::Labelling::kLive;
+    ROS_INFO(
+        "semsegmap: segmentation network %s beside the scans (%.2f cores, at most %.1f "
+        "pictures a second per camera)",
+        semantics.model.c_str(), semantics.budget_cores, semantics.rate_hz);
+  }
 
   // What the worker does with a frame: localize it, or add it to the map (under the lock that
   // ~save_map takes to copy the map so far).

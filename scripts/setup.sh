@@ -9,7 +9,7 @@ packages=(
   ccache
   libeigen3-dev libembree-dev libtbb-dev libyaml-cpp-dev libopencv-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libtorch-dev libpcl-dev libqhull-dev libfaiss-dev libceres-dev
+  libtorch-dev libonnx-dev libpcl-dev libqhull-dev libfaiss-dev libceres-dev
   libopenblas0-openmp
   nlohmann-json3-dev
   libsqlite3-dev libfastcdr-dev libzstd-dev liblz4-dev

@@ -14,6 +14,8 @@ renamed, so an interrupted run leaves the old one whole. KIND says what the inpu
   table-i       localization.json of `eval localization|paper`: the paper's Table I
   configs       localization.json with many --configs: within 1 m per run, a row per config
   label-noise   LEVEL=localization.json ...: within 1 m per run and config, a row per level
+  label-rate    LABELS=localization.json ...: SemSegMap and SegMap within 1 m, SemSegMap's lead
+                and the network's share of the cores, a row per way of labelling
   segmentation  segmentation.json of `eval segmentation|paper`
   descriptors   descriptors.json of `eval descriptors|paper`
   benchmarks    Google Benchmark JSON (`semsegmap_bench --benchmark_out=FILE`)
@@ -96,7 +98,10 @@ RUN_HEADER = [("run", 0), ("config", 0), ("localizations", 1), ("< 1 m", 1),
 
 def run_row(r):
     """A localization result's cells as the rigs and demo tables show them."""
-    return [r["run"], r["config"], r["n_localizations"], shown(r.get("n_error_below_1m")),
+    # Labels from a network (the demo's second half) are said beside the config's name.
+    labels = r.get("labels", "perfect")
+    config = r["config"] if labels == "perfect" else f"{r['config']}, {labels} labels"
+    return [r["run"], config, r["n_localizations"], shown(r.get("n_error_below_1m")),
             r["n_wrong"], mean_error(r), f"{r['recall_along_trajectory']:.2f}"]
 
 
@@ -154,10 +159,23 @@ def configs_table(inputs):
     return table(header + [("wrong", 1), ("recall " + " / ".join(runs), 1)], rows)
 
 
+def results_with_labels(path, wanted):
+    """The results of a localization.json whose camera labels are `wanted` ("perfect",
+    "network", ...), when it holds several kinds (the demo: perfect, then the network's); a file
+    of one kind gives all of its results."""
+    results = load_localization(path)["results"]
+    kinds = {r.get("labels", "perfect") for r in results}
+    if len(kinds) <= 1:
+        return results
+    if wanted not in kinds:
+        fail(f"{path}: holds results with labels {', '.join(sorted(kinds))}, not '{wanted}'")
+    return [r for r in results if r.get("labels", "perfect") == wanted]
+
+
 def label_noise_table(inputs):
     rows, columns = [], []
     for level, path in labelled(inputs):
-        results = load_localization(path)["results"]
+        results = results_with_labels(path, "perfect")
         columns = columns or [(r["run"], r["config"]) for r in results]
         found = {(r["run"], r["config"]): r for r in results}
         cells = [shown(found[c].get("n_error_below_1m")) if c in found else "-" for c in columns]
@@ -166,6 +184,30 @@ def label_noise_table(inputs):
     header = ([("label noise", 1)] + [(f"{run} {config}", 1) for run, config in columns] +
               [("wrong", 1)])
     return table(header, rows)
+
+
+def label_rate_table(inputs):
+    """Within 1 m per run for SemSegMap and SegMap, SemSegMap's lead (x SegMap's), the wrong
+    ones and the network's share of the cores, a row per way of making the camera labels."""
+    rows, runs = [], []
+    for labels, path in labelled(inputs):
+        # The label names the kind to take from a file of several: "perfect", "network".
+        results = results_with_labels(path, labels.split(" ")[0])
+        found = {(r["run"], r["config"]): r for r in results}
+        runs = runs or sorted({r["run"] for r in results})
+        row = [labels]
+        for run in runs:
+            sem = found.get((run, "semsegmap"), {}).get("n_error_below_1m")
+            seg = found.get((run, "segmap"), {}).get("n_error_below_1m")
+            lead = f"{sem / seg:.2f}" if sem is not None and seg else "-"
+            row += [shown(sem), shown(seg), lead]
+        share = max((r.get("network_share_of_cores", 0.0) for r in results), default=0.0)
+        row += [sum(r["n_wrong"] for r in results), f"{share:.2f}" if share else "-"]
+        rows.append(row)
+    header = [("camera labels", 0)]
+    for run in runs:
+        header += [(f"{run} semsegmap", 1), (f"{run} segmap", 1), (f"{run} lead", 1)]
+    return table(header + [("wrong", 1), ("network cores", 1)], rows)
 
 
 def segmentation_table(inputs):
@@ -466,7 +508,8 @@ def registration_table(inputs):
 
 
 TABLES = {"rigs": rigs_table, "runs": runs_table, "table-i": table_i, "configs": configs_table,
-          "label-noise": label_noise_table, "segmentation": segmentation_table,
+          "label-noise": label_noise_table, "label-rate": label_rate_table,
+          "segmentation": segmentation_table,
           "descriptors": descriptors_table, "benchmarks": benchmarks_table,
           "memory": memory_table, "slam": slam_table,
           "segments": segments_table, "odometry": odometry_table,

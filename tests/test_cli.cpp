@@ -107,6 +107,9 @@ const std::vector<CommandOptions> kAllCommands = {
     {"odometry",
      {"dataset", "rig", "ground-truth", "kitti-calib", "out", "config", "max-frames"},
      {"map", "poses", "odometry"}},
+    {"train-segmentation",
+     {"dataset", "out", "epochs", "threads", "input", "every", "max-frames", "seed", "history"},
+     {"config", "descriptor", "batch"}},
     {"train",
      {"descriptor",
       "dataset",
@@ -140,7 +143,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"configs", "map-run"}},
     {"eval localization",
      {"world-seed", "out", "preset", "max-frames", "configs", "map-run", "query-runs",
-      "label-noise", "odometry", "rig"},
+      "label-noise", "labels", "odometry", "rig"},
      {"descriptors", "segmentation-run"}},
     {"eval revisits",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "map-frames",
@@ -151,16 +154,18 @@ const std::vector<CommandOptions> kAllCommands = {
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
       "max-frames"},
      {"world-seed", "configs", "map-frames"}},
+    {"eval labels", {"dataset", "config", "out", "every", "max-frames"}, {"rig", "labels"}},
     {"eval paper",
      {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run", "config",
       "models", "descriptors", "threads", "descriptor-run", "map-run", "query-runs"},
      {"dataset"}},
 };
 
-// Whether this build has a command: those of the simulator need SEMSEGMAP_WITH_SIM, train needs
-// SEMSEGMAP_WITH_TORCH.
+// Whether this build has a command: those of the simulator need SEMSEGMAP_WITH_SIM, train and
+// train-segmentation need SEMSEGMAP_WITH_TORCH.
 bool built(const std::string& command) {
-  if (command == "train") return SEMSEGMAP_WITH_TORCH;
+  if (command == "train" || command == "train-segmentation") return SEMSEGMAP_WITH_TORCH;
+  if (command == "eval labels") return true;     // any dataset with label images
   if (command == "eval revisits") return true;   // any recording with ground truth
   if (command == "eval semantics") return true;  // any dataset with per-point ground truth
   if (command.rfind("simulate", 0) == 0 || command == "demo" || command.rfind("eval", 0) == 0)
@@ -294,7 +299,8 @@ TEST(Cli, CommandsNotInThisBuildSayWhyInOneLine) {
   if (absent.empty()) GTEST_SKIP() << "this build has every command";
   for (const CommandOptions& c : absent) {
     SCOPED_TRACE(c.command);
-    const std::string option = c.command == "train" ? "SEMSEGMAP_WITH_TORCH" : "SEMSEGMAP_WITH_SIM";
+    const std::string option =
+        c.command.rfind("train", 0) == 0 ? "SEMSEGMAP_WITH_TORCH" : "SEMSEGMAP_WITH_SIM";
     for (const std::string& args : {c.command + " --out o", c.command + " --help"}) {
       const Result r = run(args);
       EXPECT_EQ(r.code, 1) << r.err;
@@ -436,6 +442,28 @@ TEST(Cli, UsageErrorsExitTwoWithAHint) {
 
 // A typo gets the nearest known name in its one line: a command, an option (also with one dash),
 // an experiment, a choice; a word far from every name gets no guess.
+// eval localization --labels: the network's spec is checked before any frame is rendered.
+TEST(Cli, EvalLocalizationLabelsAreCheckedBeforeTheWork) {
+  if (!built("eval localization")) GTEST_SKIP() << "no simulator in this build";
+  const std::pair<const char*, const char*> usage[] = {
+      {"netwrk", "--labels expects perfect or network"},
+      {"network,rate=abc", "--labels: rate=abc needs a positive number"},
+      {"network,rate=-1", "--labels: rate=-1 needs a positive number"},
+      {"network,speed=2", "--labels: unknown key 'speed=2'"},
+  };
+  for (const auto& [spec, message] : usage) {
+    const Result r = run(std::string("eval localization --out o --labels ") + spec);
+    EXPECT_EQ(r.code, 2) << spec << ": " << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+  }
+  const Result both = run("eval localization --out o --labels network --label-noise 2");
+  EXPECT_EQ(both.code, 2);
+  EXPECT_NE(both.err.find("give one of them"), std::string::npos) << both.err;
+  const Result missing = run("eval localization --out o --labels network,config=/nonexistent.yaml");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("/nonexistent.yaml"), std::string::npos) << missing.err;
+}
+
 TEST(Cli, UnknownNamesSuggestTheNearestKnownOne) {
   auto expectUsage = [](const std::string& args, const std::string& line) {
     const Result r = run(args);

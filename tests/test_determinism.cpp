@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -120,4 +121,42 @@ TEST(Determinism, SameCommandSameFilesWhateverTheThreadCount) {
   }
   // Something was localized, or the comparison says little.
   EXPECT_GT(summaryWithoutTimings(a / "loc" / "summary.json")["n_localizations"].get<int>(), 5);
+}
+
+// The segmentation network on a budget, replayed on the data's clock: a third of a core and
+// 25 ms a picture labels some pictures and carries their labels to the scans between, the same
+// way on every run, so `map` and `localize` write the same files again.
+TEST(Determinism, TheNetworksBudgetReplaysTheSameFiles) {
+  const semsegmap::test_support::TempDir tmp;
+  const fs::path source = SEMSEGMAP_SOURCE_DIR;
+  std::string yaml = readFile(source / "config" / "semsegmap.yaml");
+  const std::string models = "../models/";
+  yaml.replace(yaml.find(models), models.size(), (source / "models").string() + "/");
+  yaml += "semantics:\n  model: " + (source / "models" / "semsegmap-seg.onnx").string() +
+          "\n  class_map: semsegmap\n  input_width: 320\n  input_height: 240\n"
+          "  threads: 1\n  replace_dataset_labels: true\n"
+          "  budget_cores: 0.3\n  latency_s: 0.025\n  tolerance_s: 0.5\n";
+  const fs::path config = tmp.path() / "network.yaml";
+  std::ofstream(config) << yaml;
+  std::vector<std::string> maps;
+  for (const char* name : {"a", "b"}) {
+    const fs::path dir = tmp.path() / name;
+    fs::create_directories(dir);
+    ASSERT_EQ(run("",
+                  "map --dataset sim:world=1,run=S2,preset=tiny --max-frames 25 --points 16"
+                  " --config '" +
+                      config.string() + "' --out '" + (dir / "s2.map").string() + "'",
+                  dir / "map.log"),
+              0)
+        << readFile(dir / "map.log");
+    maps.push_back(readFile(dir / "s2.map"));
+  }
+  ASSERT_GT(maps[0].size(), 1000u) << "the map should hold segments";
+  EXPECT_EQ(maps[1], maps[0]);
+  // The budget did what it is for: some pictures were not labelled, their scans took earlier
+  // labels.
+  const std::string log = readFile(tmp.path() / "a" / "map.log");
+  const size_t at = log.find("an earlier picture's ");
+  ASSERT_NE(at, std::string::npos) << log;
+  EXPECT_GT(std::stoi(log.substr(at + 21)), 0) << log;
 }

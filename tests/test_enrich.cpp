@@ -53,7 +53,7 @@ Camera makeCamera(const std::string& name, double yaw_deg = 0.0,
 // Every pixel a different colour and a label that changes from pixel to pixel, so that a point
 // landing one pixel off would get visibly different values.
 CameraFrame patternImages(const Camera& cam) {
-  CameraFrame cf{Image(cam.width, cam.height, 3), Image(cam.width, cam.height, 1)};
+  CameraFrame cf{Image(cam.width, cam.height, 3), Image(cam.width, cam.height, 1), std::nullopt};
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
       uint8_t* p = cf.rgb.at(x, y);
@@ -66,7 +66,7 @@ CameraFrame patternImages(const Camera& cam) {
 }
 
 CameraFrame uniformImages(const Camera& cam, uint8_t r, uint8_t g, uint8_t b, ClassId label) {
-  CameraFrame cf{Image(cam.width, cam.height, 3), Image(cam.width, cam.height, 1)};
+  CameraFrame cf{Image(cam.width, cam.height, 3), Image(cam.width, cam.height, 1), std::nullopt};
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
       uint8_t* p = cf.rgb.at(x, y);
@@ -422,6 +422,51 @@ TEST(Enrich, LabelImagesWinOverPointLabelsButInstancesAreCopied) {
   EXPECT_FALSE(cloud[1].has_class);  // the camera semantics do not reach it
   EXPECT_EQ(cloud[1].class_id, cls::kUnknown);
   EXPECT_EQ(cloud[1].instance_id, 4);
+}
+
+// A network on a budget: the labels of an earlier picture are read where the point was when it
+// was taken (CameraFrame::T_label_lidar), the colour where it is now.
+TEST(Enrich, LabelsOfAnEarlierPictureAreReadWhereThePointWasThen) {
+  SensorRig rig;
+  rig.cameras = {makeCamera("cam")};
+  const Camera& cam = rig.cameras[0];
+  Frame f;
+  CameraFrame cf = patternImages(cam);
+  Pose T_then_now = Pose::Identity();
+  T_then_now.translation() = Eigen::Vector3d(0.0, 2.0, 0.0);  // 2 m to the left then
+  cf.T_label_lidar = T_then_now;
+  f.cameras = {cf};
+  f.points = {pointAtPixel(cam, 20.5, 10.5, 10.0), pointAtPixel(cam, 0.5, 10.5, 2.0)};
+  const EnrichedCloud cloud = enrichFrame(f, rig, EnrichmentConfig{});
+  const LidarPoint& p = f.points[0];
+  const auto then = cam.project(cam.T_camera_lidar * (T_then_now * Eigen::Vector3d(p.x, p.y, p.z)));
+  ASSERT_TRUE(then && cam.inImage(*then));
+  const int x = static_cast<int>(then->x()), y = static_cast<int>(then->y());
+  ASSERT_NE(x, 20) << "the motion must move the point in the picture";
+  expectColourOf(cloud[0], cf.rgb, 20, 10);
+  ASSERT_TRUE(cloud[0].has_class);
+  EXPECT_EQ(cloud[0].class_id, *cf.label.at(x, y));
+  // A near point at the left edge was outside the earlier picture: coloured, without class.
+  EXPECT_TRUE(cloud[1].has_color);
+  EXPECT_FALSE(cloud[1].has_class);
+}
+
+// A run whose classes come from the cameras (Frame::camera_semantics) gives a scan no camera
+// has labels for yet no classes at all: the point labels are ground truth, never an input.
+TEST(Enrich, AScanWithoutLabelsYetTakesNoClassFromPointLabels) {
+  SensorRig rig;
+  rig.cameras = {makeCamera("cam")};
+  Frame f;
+  CameraFrame cf = patternImages(rig.cameras[0]);
+  cf.label = Image();
+  f.cameras = {cf};
+  f.camera_semantics = true;
+  f.points = {pointAtPixel(rig.cameras[0], 5.5, 6.5, 7.0)};
+  f.point_labels = {PointLabel{cls::kPole, 17}};
+  const EnrichedCloud cloud = enrichFrame(f, rig, EnrichmentConfig{});
+  expectColourOf(cloud[0], cf.rgb, 5, 6);
+  EXPECT_FALSE(cloud[0].has_class);
+  EXPECT_EQ(cloud[0].instance_id, 17);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -4,7 +4,10 @@
 // the rate at which it runs, label sets, and the one-line errors of each.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <fstream>
+#include <thread>
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/open_dataset.h"
@@ -13,6 +16,7 @@
 #include "semsegmap/io/label_set.h"
 #include "semsegmap/pipeline/pipeline.h"
 #include "semsegmap/semantics/frame_labeler.h"
+#include "semsegmap/semantics/live_labeler.h"
 #include "semsegmap/settings/class_map_file.h"
 #include "semsegmap/settings/config.h"
 #include "temp_dir.h"
@@ -233,42 +237,152 @@ Frame twoCameraFrame(double t) {
 }
 
 TEST(FrameLabeler, LabelsEveryCameraWithoutLabelsAndKeepsTheDatasets) {
-  FrameLabeler labeler(network(plainConfig()));
+  ReplayLabeler labeler(network(plainConfig()));
   Frame f = twoCameraFrame(0.0);
   labeler.label(f, "frame 0");
   EXPECT_EQ(quadrantClasses(f.cameras[0].label), kExpected);
   EXPECT_EQ(f.cameras[1].label, Image(16, 16, 1, cls::kPole));
+  EXPECT_TRUE(f.camera_semantics);
   EXPECT_EQ(labeler.stats().network_runs, 1u);
   EXPECT_EQ(labeler.stats().kept, 1u);
   SemanticsConfig replace = plainConfig();
   replace.replace_dataset_labels = true;
-  FrameLabeler replacing(network(replace));
+  ReplayLabeler replacing(network(replace));
   Frame g = twoCameraFrame(0.0);
   replacing.label(g, "frame 0");
   EXPECT_EQ(quadrantClasses(g.cameras[1].label), kExpected);
   EXPECT_EQ(replacing.stats().network_runs, 2u);
 }
 
-TEST(FrameLabeler, RunsAtItsRateAndReusesRecentLabels) {
+// The robot drives 1 m along x between scans: an earlier picture's labels come with the motion.
+Frame movingFrame(double t) {
+  Frame f = twoCameraFrame(t);
+  f.T_odom_base.translation() = Eigen::Vector3d(10.0 * t, 0.0, 0.0);
+  return f;
+}
+
+TEST(FrameLabeler, RunsAtItsRateAndCarriesEarlierLabelsByOdometry) {
   SemanticsConfig c = plainConfig();
   c.rate_hz = 5.0;  // every 0.2 s; scans every 0.1 s
   c.tolerance_s = 0.15;
-  FrameLabeler labeler(network(c));
+  ReplayLabeler labeler(network(c));
   for (double t : {0.0, 0.1, 0.2, 0.3, 0.4}) {
-    Frame f = twoCameraFrame(t);
+    Frame f = movingFrame(t);
     labeler.label(f, "frame");
     EXPECT_EQ(quadrantClasses(f.cameras[0].label), kExpected) << t;
+    const bool own = t == 0.0 || t == 0.2 || t == 0.4;
+    ASSERT_EQ(f.cameras[0].T_label_lidar.has_value(), !own) << t;
+    // Labels of the picture 0.1 s before: the LiDAR then was 1 m behind, so a point now is
+    // 1 m further ahead of it.
+    if (!own) {
+      EXPECT_NEAR(f.cameras[0].T_label_lidar->translation().x(), 1.0, 1e-9) << t;
+    }
   }
   EXPECT_EQ(labeler.stats().network_runs, 3u);  // 0.0, 0.2, 0.4
   EXPECT_EQ(labeler.stats().reused, 2u);        // 0.1, 0.3
-  // Labels older than the tolerance are not reused, whatever the rate.
+  // Labels older than the tolerance are not taken: that scan gets no classes from the camera.
   c.tolerance_s = 0.05;
-  FrameLabeler strict(network(c));
+  ReplayLabeler strict(network(c));
   for (double t : {0.0, 0.1, 0.2}) {
-    Frame f = twoCameraFrame(t);
+    Frame f = movingFrame(t);
     strict.label(f, "frame");
+    EXPECT_EQ(f.cameras[0].label.empty(), t == 0.1) << t;
+    EXPECT_TRUE(f.camera_semantics);
   }
-  EXPECT_EQ(strict.stats().network_runs, 3u);
+  EXPECT_EQ(strict.stats().network_runs, 2u);
+  EXPECT_EQ(strict.stats().unlabelled, 1u);
+}
+
+// Two cameras to label at 10 Hz, a network of 40 ms on one thread and a fifth of a core: the
+// replay runs it every 0.2 s, alternating cameras, and each scan takes labels only once they
+// are done (0.04 s after their picture).
+TEST(FrameLabeler, ReplaysTheBudgetOnTheDatasClock) {
+  SemanticsConfig c = plainConfig();
+  c.budget_cores = 0.2;
+  c.latency_s = 0.04;
+  c.threads = 1;
+  std::vector<std::pair<size_t, double>> runs;  // camera, picture time
+  auto record = [&](const Image& rgb, const std::string& what) {
+    runs.emplace_back(what.back() - '0', std::stod(what.substr(0, what.find(','))));
+    return Image(rgb.width, rgb.height, 1, cls::kRoad);
+  };
+  ReplayLabeler labeler(c, record);
+  std::vector<bool> camera0_labelled;
+  for (int i = 0; i <= 100; ++i) {
+    Frame f = movingFrame(0.1 * i);
+    f.cameras[1].label = Image();  // both cameras need the network
+    labeler.label(f, std::to_string(0.1 * i));
+    camera0_labelled.push_back(!f.cameras[0].label.empty());
+  }
+  ASSERT_GE(runs.size(), 4u);
+  EXPECT_EQ(runs[0], std::make_pair(size_t{0}, 0.0));
+  EXPECT_EQ(runs[1].first, 1u);
+  EXPECT_NEAR(runs[1].second, 0.2, 1e-9);
+  EXPECT_EQ(runs[2].first, 0u);
+  EXPECT_NEAR(runs[2].second, 0.4, 1e-9);
+  EXPECT_EQ(runs.size(), 51u);  // every 0.2 s over 10 s
+  EXPECT_NEAR(labeler.stats().share(), 0.2, 0.01);
+  // Camera 0's labels of t = 0 are done at 0.04: the scan at 0 has none, the one at 0.1 has them.
+  EXPECT_FALSE(camera0_labelled[0]);
+  EXPECT_TRUE(camera0_labelled[1]);
+  SemanticsConfig no_latency = c;  // a budget cannot be replayed without the network's time
+  no_latency.latency_s = 0.0;
+  EXPECT_THROW(ReplayLabeler(no_latency, record), std::invalid_argument);
+  EXPECT_TRUE(throwsWith([&] { checkReplayable(no_latency, "c.yaml"); },
+                         {"c.yaml: semantics.budget_cores", "latency_s"}));
+}
+
+// On a robot the network runs beside the scans: one slowed down to 0.3 s a picture does not
+// slow the scan loop, and its labels reach the scans once done.
+TEST(LiveLabeler, ASlowNetworkNeverBlocksTheScans) {
+  SemanticsConfig c = plainConfig();
+  c.tolerance_s = 100.0;
+  std::atomic<int> runs{0};
+  auto slow = [&](const Image& rgb, const std::string&) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ++runs;
+    return Image(rgb.width, rgb.height, 1, cls::kRoad);
+  };
+  LiveLabeler labeler(c, slow, Pose::Identity());
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 20; ++i) {
+    Frame f = movingFrame(0.1 * i);
+    labeler.label(f, "frame");
+    EXPECT_TRUE(f.cameras[0].label.empty()) << "labels before the network finished: " << i;
+  }
+  const double loop_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(loop_s, 0.3) << "the scans waited for the network";
+  labeler.waitIdle();
+  Frame later = movingFrame(2.0);
+  labeler.label(later, "frame");
+  ASSERT_FALSE(later.cameras[0].label.empty());
+  EXPECT_EQ(*later.cameras[0].label.at(0, 0), cls::kRoad);
+  EXPECT_TRUE(later.cameras[0].T_label_lidar.has_value());
+  EXPECT_LE(runs.load(), 3);  // it took the newest pictures, not every one
+}
+
+// The worker keeps to budget_cores of the wall clock: a network of 20 ms a picture on one
+// thread, a quarter of a core, scans every 5 ms for a second.
+TEST(LiveLabeler, KeepsToItsShareOfTheCores) {
+  SemanticsConfig c = plainConfig();
+  c.budget_cores = 0.25;
+  c.threads = 1;
+  auto work = [](const Image& rgb, const std::string&) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return Image(rgb.width, rgb.height, 1, cls::kRoad);
+  };
+  LiveLabeler labeler(c, work, Pose::Identity());
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; std::chrono::steady_clock::now() - start < std::chrono::seconds(1); ++i) {
+    Frame f = movingFrame(0.005 * i);
+    labeler.label(f, "frame");
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const LabelingStats s = labeler.stats();
+  EXPECT_LE(s.share(), 0.25 * 1.1) << s.network_runs << " runs in " << s.span_s << " s";
+  EXPECT_GE(s.share(), 0.1) << "the worker did not use its budget";
+  EXPECT_GE(s.network_runs, 5u);
 }
 
 // Frames held in memory: two of a one-camera rig.
@@ -421,7 +535,7 @@ TEST(FrontEndStages, APipelineLabelsAndRegistersItsFramesAsAWrappedSourceDoes) {
     }
   }
   EXPECT_GT(relabelled, 0u) << "the caller's frames kept the simulator's labels";
-  ASSERT_NE(by_stages.labeling(), nullptr);
+  ASSERT_TRUE(by_stages.labeling().has_value());
   EXPECT_EQ(by_stages.labeling()->network_runs,
             wrapped->size() * wrapped->info().rig.cameras.size());
 }

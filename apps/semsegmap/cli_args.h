@@ -114,6 +114,7 @@ const CommandSpec& localizeCommand();
 const CommandSpec& slamCommand();
 const CommandSpec& odometryCommand();
 const CommandSpec& trainCommand();
-const CommandSpec& viewCommand();  // a build with the viewer (SEMSEGMAP_WITH_VIEWER)
+const CommandSpec& trainSegmentationCommand();  // a build with libtorch
+const CommandSpec& viewCommand();               // a build with the viewer (SEMSEGMAP_WITH_VIEWER)
 
 }  // namespace semsegmap::app

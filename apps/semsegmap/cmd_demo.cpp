@@ -15,6 +15,7 @@
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/report.h"
+#include "semsegmap/settings/config.h"
 #include "semsegmap/sim/simulator.h"
 #include "semsegmap/viz/sim_overview.h"
 #if SEMSEGMAP_WITH_VIEWER
@@ -45,6 +46,25 @@ std::string writeDemoView(const LocalizationExperiment& e, const std::filesystem
   return "";
 }
 
+// The same runs with the camera labels of the shipped segmentation network at its shipped
+// budget instead of the simulator's perfect ones (the paper's whole pipeline): their rows join
+// the table, their files go to out/network/.
+void addNetworkRows(LocalizationExperiment& e, LocalizationExperimentConfig config,
+                    const std::filesystem::path& out, StageProgress& progress) {
+  config.labels = "network";
+  config.network = loadSemanticsConfig(shippedFile("config/semantics-sim-network.yaml"));
+  config.class_maps_dir = shippedFile("config/class_maps");
+  std::cout << "and again with the shipped segmentation network's labels ("
+            << config.network.budget_cores << " cores, at most " << config.network.rate_hz
+            << " pictures a second per camera)\n";
+  LocalizationExperiment n = evaluateLocalization(config, out / "network", std::ref(progress));
+  for (LocalizationResult& r : n.results) {
+    r.dir = std::filesystem::path("network") / r.dir;
+    e.results.push_back(std::move(r));
+  }
+  e.interrupted = n.interrupted;
+}
+
 int runDemo(const CliArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   const std::filesystem::path out = a.get("out");
@@ -65,9 +85,10 @@ int runDemo(const CliArgs& a) {
   viz::writeSimOverview(sim::worldPreset(config.preset, config.world_seed), out / "overview.png");
   config.stop = stopToken();
   StageProgress progress;
-  const LocalizationExperiment e = evaluateLocalization(config, out, std::ref(progress));
+  LocalizationExperiment e = evaluateLocalization(config, out, std::ref(progress));
   // Ctrl-C before the first frame: nothing worth keeping (main removes the folder's new files).
   if (e.interrupted && !progress.started()) return interruptedStages("demo", progress, "");
+  if (!e.interrupted) addNetworkRows(e, config, out, progress);
   writeLocalizationFiles(e, out);
   std::cout << "\n" << localizationTable(e) << "\n";
 

@@ -2,6 +2,7 @@
 // printing its table and writing JSON and pictures; `eval paper` runs all three and writes
 // report.md.
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -82,6 +83,47 @@ DescriptorExperimentConfig descriptorConfig(const CliArgs& a) {
   return c;
 }
 
+// --labels perfect | network[,rate=R][,budget=C][,every][,config=FILE]: the simulator's labels,
+// or the shipped segmentation network's (config/semantics-sim-network.yaml, or FILE's
+// semantics: section) at its shipped budget, at R pictures a second per camera, within C cores,
+// or on every picture.
+void setLabels(LocalizationExperimentConfig& c, const std::string& spec) {
+  c.labels = spec;
+  if (spec == "perfect") return;
+  const std::vector<std::string> keys = splitList(spec);
+  if (keys.empty() || keys.front() != "network")
+    throw UsageError(
+        "--labels expects perfect or network[,rate=R][,budget=C][,every]"
+        "[,config=FILE], got '" +
+        spec + "'");
+  std::filesystem::path file = shippedFile("config/semantics-sim-network.yaml");
+  for (size_t i = 1; i < keys.size(); ++i)
+    if (keys[i].rfind("config=", 0) == 0) file = keys[i].substr(7);
+  c.network = loadSemanticsConfig(file);
+  c.class_maps_dir = shippedFile("config/class_maps");
+  for (size_t i = 1; i < keys.size(); ++i) {
+    const std::string& k = keys[i];
+    const auto number = [&](size_t at) {
+      char* end = nullptr;
+      const double v = std::strtod(k.c_str() + at, &end);
+      if (end == k.c_str() + at || *end != '\0' || !(v > 0))
+        throw UsageError("--labels: " + k + " needs a positive number");
+      return v;
+    };
+    if (k.rfind("rate=", 0) == 0) {
+      c.network.rate_hz = number(5);
+      c.network.budget_cores = 0;  // the rate alone limits the network
+    } else if (k.rfind("budget=", 0) == 0) {
+      c.network.budget_cores = number(7);
+    } else if (k == "every") {
+      c.network.rate_hz = c.network.budget_cores = c.network.latency_s = 0;
+    } else if (k.rfind("config=", 0) != 0) {
+      throw UsageError("--labels: unknown key '" + k + "' (rate=R, budget=C, every, config=FILE)");
+    }
+  }
+  checkReplayable(c.network, file.string());
+}
+
 LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   LocalizationExperimentConfig c;
   c.world_seed = a.getCount("world-seed");
@@ -96,6 +138,11 @@ LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   if (a.command().name != "eval localization") return c;  // the paper's setting otherwise
   c.label_noise = static_cast<int>(a.getCount("label-noise"));
   if (c.label_noise > 3) throw UsageError("--label-noise is 0 (perfect labels) to 3");
+  setLabels(c, a.get("labels"));
+  if (c.label_noise > 0 && !c.network.model.empty())
+    throw UsageError(
+        "--label-noise and --labels network: the network's labels replace the "
+        "simulator's, noisy or not; give one of them");
   if (a.has("rig")) c.rig = a.get("rig");
   const std::string odometry = a.get("odometry");
   if (odometry != "simulated" && odometry != "lidar")
@@ -218,6 +265,11 @@ const OptionSpec kQueryRuns{"query-runs", Value::kText, "LIST", "S2,S3",
                             "the runs localized against the map"};
 const OptionSpec kLabelNoise{"label-noise", Value::kCount, "L", "0",
                              "camera labels as a segmentation network's, 0 (perfect) to 3"};
+const OptionSpec kLabels{
+    "labels", Value::kText, "SPEC", "perfect",
+    "camera labels: perfect (the simulator's), or network[,rate=R][,budget=C][,every]"
+    "[,config=FILE]: the shipped segmentation network's on its budget, at R pictures a second "
+    "per camera, within C cores, or on every picture"};
 const OptionSpec kRig{"rig", Value::kText, "KEYS", "",
                       "simulator keys for every run's rig, e.g. lidar=hdl64,cameras=front"};
 const OptionSpec kQueryOdometry{
@@ -245,7 +297,7 @@ const std::vector<const CommandSpec*>& simulatedEvalCommands() {
   static const CommandSpec localization{
       "eval localization",
       "maps one run, localizes the others with each config -> localization.json",
-      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kMapRun, kQueryRuns, kLabelNoise,
+      {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kMapRun, kQueryRuns, kLabelNoise, kLabels,
        kQueryOdometry, kRig},
       "",
       runEvalLocalization,

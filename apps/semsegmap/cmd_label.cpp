@@ -78,7 +78,7 @@ int runLabel(const CliArgs& a) {
   set.model = model;
   writeLabelSetInfo(out, set);
 
-  const LabelingStats& s = labelerOf(*source)->stats();
+  const LabelingStats s = labelerOf(*source)->stats();
   std::printf("frames %zu  label images %zu: network %zu (%.1f ms each), reused %zu, kept %zu\n",
               done, written, s.network_runs, s.network_runs ? s.network_ms / s.network_runs : 0.0,
               s.reused, s.kept);

@@ -46,6 +46,7 @@ void printLocalizationSummary(const LocalizationRun& run) {
   if (run.odometry_is_ground_truth && s.mean_translation_error_m)
     std::printf("  [errors against the ground truth used as odometry]");
   std::printf("\n");
+  if (run.stats.labelling) printLabelling(*run.stats.labelling);
 }
 
 // --prior X,Y[,RADIUS]: where the robot is known to be, in the map frame (radius 50 m).

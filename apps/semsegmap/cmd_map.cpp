@@ -74,6 +74,7 @@ int runMap(const CliArgs& a) {
       stats.frames, segments, kept.c_str(), duplicates, map.size(),
       static_cast<unsigned long long>(bytes),
       map.size() ? static_cast<double>(bytes) / map.size() : 0.0, stats.fps());
+  if (stats.labelling) printLabelling(*stats.labelling);
   std::cout << "wrote " << out.string() << "\n";
   if (stats.interrupted)
     return interruptedRun("map", stats.frames, options.frameCount(*source), out.string());

@@ -1,6 +1,7 @@
 #include "dataset_args.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "resources.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -55,6 +56,15 @@ DatasetOptions datasetOptionsOf(const CliArgs& a, const std::filesystem::path& c
     options.lidar_odometry = loadOdometryConfig(sections);
   // The segmentation network of the config's semantics: section labels pictures without labels.
   if (declares("labels") && !sections.empty()) options.semantics = loadSemanticsConfig(sections);
+  if (!options.semantics.model.empty() && a.command().name != "label")
+    checkReplayable(options.semantics, sections.string());
+  // A label set holds every picture's own labels; a budget is for the pipelines that read it.
+  if (a.command().name == "label" && !labelsEveryPicture(options.semantics)) {
+    note(sections.string() +
+         ": semantics: rate_hz, budget_cores and latency_s are for a pipeline; "
+         "label labels every picture");
+    options.semantics.rate_hz = options.semantics.budget_cores = options.semantics.latency_s = 0;
+  }
   if (declares("labels") && a.has("labels")) options.labels = a.get("labels");
   if (!options.semantics.model.empty() || !options.labels.empty())
     options.class_maps_dir = shippedFile("config/class_maps");
@@ -73,6 +83,14 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a, const std::filesys
 
 DatasetWithStages openDatasetForPipelineArg(const CliArgs& a) {
   return openDatasetForPipeline(a.get("dataset"), datasetOptionsOf(a, {}));
+}
+
+void printLabelling(const LabelingStats& s) {
+  std::printf(
+      "network: %zu pictures labelled (%.1f ms each, %.2f of a core); pictures with "
+      "their own labels %zu, an earlier picture's %zu, none within tolerance_s %zu\n",
+      s.network_runs, s.network_runs ? s.network_ms / s.network_runs : 0.0, s.share(), s.own,
+      s.reused, s.unlabelled);
 }
 
 std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,

@@ -32,6 +32,10 @@ std::unique_ptr<FrameSource> openDatasetArg(const CliArgs& a,
 // code that embeds it.
 DatasetWithStages openDatasetForPipelineArg(const CliArgs& a);
 
+// One line: how many pictures the segmentation network labelled, at what share of the cores,
+// and how many scans took an earlier picture's labels or none (semantics/frame_labeler.h).
+void printLabelling(const LabelingStats& s);
+
 // The describer for the data `source` gives: descriptor.model, or descriptor.model_lidar_only
 // for a LiDAR without a camera (chooseDescriptor); what was chosen or assumed is printed.
 std::shared_ptr<Describer> describerFor(const DescriptorConfig& descriptor,

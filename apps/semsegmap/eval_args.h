@@ -21,5 +21,6 @@ std::vector<NamedConfig> comparedConfigs(const CliArgs& a);
 const std::vector<const CommandSpec*>& simulatedEvalCommands();
 const CommandSpec& evalRevisitsCommand();
 const CommandSpec& evalSemanticsCommand();
+const CommandSpec& evalLabelsCommand();
 
 }  // namespace semsegmap::app

@@ -36,6 +36,7 @@ const std::vector<const CommandSpec*>& commands() {
                        &odometryCommand()});
 #if SEMSEGMAP_WITH_TORCH
     c.push_back(&trainCommand());
+    c.push_back(&trainSegmentationCommand());
 #endif
 #if SEMSEGMAP_WITH_VIEWER
     c.push_back(&viewCommand());
@@ -48,8 +49,8 @@ const std::vector<const CommandSpec*>& commands() {
   return all;
 }
 
-// The experiments: those on the simulator when the build has it, and `eval revisits` and
-// `eval semantics` always.
+// The experiments: those on the simulator when the build has it, and `eval revisits`,
+// `eval semantics` and `eval labels` always.
 const std::vector<const CommandSpec*>& evalCommands() {
   static const std::vector<const CommandSpec*> all = [] {
     std::vector<const CommandSpec*> e;
@@ -58,7 +59,8 @@ const std::vector<const CommandSpec*>& evalCommands() {
 #endif
     // Before `eval paper`, which runs the others.
     const std::ptrdiff_t before_paper = e.empty() ? 0 : 1;
-    e.insert(e.end() - before_paper, {&evalRevisitsCommand(), &evalSemanticsCommand()});
+    e.insert(e.end() - before_paper,
+             {&evalRevisitsCommand(), &evalSemanticsCommand(), &evalLabelsCommand()});
     return e;
   }();
   return all;
@@ -82,6 +84,10 @@ const std::vector<AbsentCommand>& absentCommands() {
     if (!SEMSEGMAP_WITH_TORCH)
       a.push_back({"train", "SEMSEGMAP_WITH_TORCH",
                    "this build has no learned descriptors to train (built without libtorch, "
+                   "reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)"});
+    if (!SEMSEGMAP_WITH_TORCH)
+      a.push_back({"train-segmentation", "SEMSEGMAP_WITH_TORCH",
+                   "this build has no segmentation network training (built without libtorch, "
                    "reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)"});
     if (!SEMSEGMAP_WITH_VIEWER)
       a.push_back({"view", "SEMSEGMAP_WITH_VIEWER",

@@ -79,8 +79,9 @@ void bindLive(py::module_& m) {
                        size_t max_queued_frames, bool never_drop, double picture_tolerance_s,
                        double max_wait_s, const py::object& stages) {
              // LiDAR odometry or the network as stages (open_dataset_for_pipeline), or none.
-             const FrontEndStages s =
-                 stages.is_none() ? FrontEndStages{} : stages.cast<FrontEndStages>();
+             FrontEndStages s = stages.is_none() ? FrontEndStages{} : stages.cast<FrontEndStages>();
+             // A robot's network runs beside the scans within its budget, never holding them up.
+             s.labelling = FrontEndStages::Labelling::kLive;
              const LiveConfig live = liveConfigOf(info, odometry, max_queued_frames, never_drop,
                                                   picture_tolerance_s, max_wait_s);
              py::gil_scoped_release release;

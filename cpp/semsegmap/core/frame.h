@@ -29,6 +29,12 @@ struct PointLabel {
 struct CameraFrame {
   Image rgb;    // 3 channels; empty when the dataset has no color
   Image label;  // 1 channel of class ids; empty when no semantics
+  // Labels of an earlier picture of this camera (a segmentation network on a budget labels fewer
+  // pictures than the LiDAR scans): the LiDAR's frame when that picture was taken, seen from this
+  // scan's (T_then_now, from odometry). Points are moved by it before their class is read, so that
+  // a static world keeps its classes while the robot drives. nullopt: the labels are this
+  // picture's.
+  std::optional<Pose> T_label_lidar;
 };
 
 struct Frame {
@@ -44,6 +50,10 @@ struct Frame {
   // the robot moves); empty when the input has no per-point times.
   std::vector<float> point_times;
   std::vector<CameraFrame> cameras;  // in the order of SensorRig::cameras
+  // Classes come from the cameras' labels in this run, also in a scan where no camera has any
+  // yet (a network on a budget): point labels are then ground truth for evaluation, never an
+  // input, and the scan's points are coloured without classes.
+  bool camera_semantics = false;
   // Poses are named T_to_from, so that subscripts cancel: T_world_lidar = T_world_base *
   // rig.T_base_lidar. The odometry frame is where the robot's own odometry started; the world
   // frame is the dataset's ground truth, when it has one.

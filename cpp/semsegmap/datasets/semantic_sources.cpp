@@ -69,7 +69,7 @@ class NetworkSource : public RelabelledSource {
  public:
   NetworkSource(std::unique_ptr<FrameSource> source, std::shared_ptr<SegmentationNetwork> network)
       : RelabelledSource(std::move(source), "the semantics: network"),
-        labeler_(std::move(network)) {
+        labeler_(std::move(network), source_->info().rig.T_base_lidar) {
     // The network labels the pictures that have no label image of their own.
     const std::string& own = source_->info().origin.label_images;
     if (!own.empty()) info_.origin.label_images = own + ", else the semantics: network";
@@ -83,7 +83,7 @@ class NetworkSource : public RelabelledSource {
   const FrameLabeler& labeler() const { return labeler_; }
 
  private:
-  FrameLabeler labeler_;
+  ReplayLabeler labeler_;
 };
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -223,6 +224,18 @@ int bestCamera(const Frame& frame, const SensorRig& rig, const std::vector<Camer
   return best_cam;
 }
 
+// The class camera `cf` gives a point at `pixel`: read there, or, for labels of an earlier
+// picture, where the point was then (the static world seen from the LiDAR's earlier pose);
+// nothing when that picture did not see it.
+std::optional<ClassId> cameraClass(const CameraFrame& cf, const Camera& cam, const LidarPoint& lp,
+                                   size_t pixel) {
+  if (!cf.T_label_lidar) return cf.label.data[pixel];
+  const Eigen::Vector3d then = *cf.T_label_lidar * Eigen::Vector3d(lp.x, lp.y, lp.z);
+  const auto uv = cam.project(cam.T_camera_lidar * then);
+  if (!uv || !cam.inImage(*uv)) return std::nullopt;
+  return cf.label.data[static_cast<size_t>(uv->y()) * cam.width + static_cast<size_t>(uv->x())];
+}
+
 }  // namespace
 
 EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
@@ -233,7 +246,7 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
                                 std::to_string(config.occlusion_radius_px));
   const auto n = static_cast<std::ptrdiff_t>(frame.points.size());
   const size_t n_cams = frame.cameras.size();  // 0 when the frame has no images at all
-  bool camera_semantics = false;
+  bool camera_semantics = frame.camera_semantics;
   for (const auto& cf : frame.cameras) camera_semantics |= !cf.label.empty();
   // Point labels give classes only when some point has one: the simulator's point labels may
   // carry ground-truth instances alone, and those points are unobserved, not of class unknown.
@@ -274,8 +287,9 @@ EnrichedCloud enrichFrame(const Frame& frame, const SensorRig& rig,
       ep.has_color = true;
     }
     if (camera_semantics && !cf.label.empty()) {
-      ep.class_id = cf.label.data[pixel];
-      ep.has_class = true;
+      const std::optional<ClassId> c = cameraClass(cf, rig.cameras[cam], lp, pixel);
+      ep.has_class = c.has_value();
+      if (c) ep.class_id = *c;
     }
   }
   return cloud;

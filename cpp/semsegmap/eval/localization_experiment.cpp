@@ -9,6 +9,7 @@
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/open_dataset.h"
+#include "semsegmap/datasets/semantic_sources.h"
 #include "semsegmap/eval/localization_files.h"
 #include "semsegmap/eval/localization_metrics.h"
 #include "semsegmap/outputs/run_output.h"
@@ -18,6 +19,16 @@ namespace semsegmap {
 
 namespace {
 
+// How every run is opened: with the network that labels its pictures, when there is one.
+DatasetOptions runOptions(const LocalizationExperimentConfig& cfg) {
+  DatasetOptions options;
+  if (cfg.network.model.empty()) return options;
+  options.semantics = cfg.network;
+  options.semantics.replace_dataset_labels = true;  // the simulator's are perfect
+  options.class_maps_dir = cfg.class_maps_dir;
+  return options;
+}
+
 // The map run, rendered once for every configuration; each map is saved into out/maps/ (when
 // interrupted, the map of the frames done: a whole map of a shorter run).
 std::vector<BuiltMap> buildMaps(LocalizationExperiment& e,
@@ -26,7 +37,8 @@ std::vector<BuiltMap> buildMaps(LocalizationExperiment& e,
                                 const ExperimentProgress& progress) {
   const LocalizationExperimentConfig& cfg = e.config;
   auto source = openDataset(simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset,
-                                             cfg.max_frames, cfg.label_noise, cfg.rig));
+                                             cfg.max_frames, cfg.label_noise, cfg.rig),
+                            runOptions(cfg));
   auto sessions =
       mappingSessions(cfg.configs, source->info(), describers, cfg.picture_points_per_segment);
   e.interrupted =
@@ -89,7 +101,7 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
                  const std::vector<BuiltMap>& maps, const std::filesystem::path& out,
                  const ExperimentProgress& progress) {
   const LocalizationExperimentConfig& cfg = e.config;
-  DatasetOptions options;
+  DatasetOptions options = runOptions(cfg);
   if (cfg.lidar_odometry) {
     options.odometry = "lidar";
     options.lidar_odometry = cfg.odometry;
@@ -110,6 +122,8 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
     run.stats.interrupted = e.interrupted;  // its summary.json says the frames are those done
     LocalizationResult r = resultOf(e, cfg.configs[c], run_name, run, maps[c]);
     r.dataset = source->info().name;
+    r.labels = cfg.labels;
+    if (const FrameLabeler* labeler = labelerOf(*source)) r.labelling = labeler->stats();
     writeRunFiles(cfg, cfg.configs[c], run, maps[c], r, out);
     e.results.push_back(std::move(r));
   }
@@ -121,6 +135,11 @@ nlohmann::ordered_json toJson(const LocalizationResult& r) {
           {"descriptor", r.descriptor},
           {"run", r.run},
           {"dataset", r.dataset},
+          {"labels", r.labels},
+          {"network_pictures", r.labelling.network_runs},
+          {"network_share_of_cores", r.labelling.share()},
+          {"pictures_with_earlier_labels", r.labelling.reused},
+          {"pictures_without_labels", r.labelling.unlabelled},
           {"frames", r.frames},
           {"distance_m", r.distance_m},
           {"n_localizations", s.localizations},
@@ -201,6 +220,14 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
   j["preset"] = e.config.preset;
   j["map_run"] = e.config.map_run;
   j["label_noise"] = e.config.label_noise;
+  j["labels"] = e.config.labels;
+  if (!e.config.network.model.empty()) {
+    j["network"] = {{"model", e.config.network.model},
+                    {"rate_hz", e.config.network.rate_hz},
+                    {"budget_cores", e.config.network.budget_cores},
+                    {"latency_s", e.config.network.latency_s},
+                    {"tolerance_s", e.config.network.tolerance_s}};
+  }
   j["rig"] = e.config.rig;
   j["query_odometry"] = e.config.lidar_odometry ? "lidar" : "simulated";
   j["correct_m"] = e.config.correct_m;
@@ -231,6 +258,13 @@ LocalizationExperiment runLocalizationExperiment(const LocalizationExperimentCon
   return e;
 }
 
+namespace {
+// A configuration's name, and where its labels came from when not the simulator's.
+std::string configText(const LocalizationResult& r) {
+  return r.labels.empty() || r.labels == "perfect" ? r.config : r.config + ", " + r.labels;
+}
+}  // namespace
+
 std::string localizationTable(const LocalizationExperiment& e) {
   std::ostringstream t;
   t << "| run | config | localizations | < 1 m | < 5 m | wrong (> 5 m) | mean error | recall "
@@ -243,7 +277,7 @@ std::string localizationTable(const LocalizationExperiment& e) {
     const int paper_n = semantic ? paper.second : paper.first;
     std::snprintf(line, sizeof(line),
                   "| %s | %s | %zu | %s | %s | %zu | %s | %.2f | %.1f | %zu | %.1f | %s |\n",
-                  r.run.c_str(), r.config.c_str(), r.summary.localizations,
+                  r.run.c_str(), configText(r).c_str(), r.summary.localizations,
                   countText(r.summary.below_1m).c_str(), countText(r.summary.below_5m).c_str(),
                   r.wrong, meanErrorText(r.summary).c_str(), r.recall, r.hz, r.map_segments,
                   static_cast<double>(r.map_bytes) / 1024.0,

@@ -11,6 +11,7 @@
 #include "semsegmap/eval/experiment.h"
 #include "semsegmap/odometry/lidar_odometry.h"
 #include "semsegmap/pipeline/modes.h"
+#include "semsegmap/semantics/frame_labeler.h"
 
 namespace semsegmap {
 
@@ -22,6 +23,13 @@ struct LocalizationExperimentConfig {
   size_t max_frames = 0;  // per run; 0: all
   // Camera labels of every run as a segmentation network's (sim/label_noise.h): 0 perfect.
   int label_noise = 0;
+  // Camera labels of every run (map and queries) from this segmentation network instead of the
+  // simulator's, within the budget of its settings (replayed on the data's clock); the same
+  // labels reach every configuration. Empty model: the simulator's labels. `labels` says which,
+  // for the files and tables ("perfect", "network", "network,rate=2").
+  SemanticsConfig network;
+  std::filesystem::path class_maps_dir;  // the shipped class maps, for network.class_map
+  std::string labels = "perfect";
   // Simulator keys appended to every run's spec: the rig, e.g. "lidar=hdl64,cameras=front".
   std::string rig;
   // The query runs' odometry from LiDAR odometry on their scans (odometry/), with these
@@ -40,6 +48,8 @@ struct LocalizationExperimentConfig {
 
 struct LocalizationResult {  // one configuration on one query run
   std::string config, descriptor, fingerprint, run, dataset;
+  std::string labels;       // LocalizationExperimentConfig::labels
+  LabelingStats labelling;  // of the query run, when a network labelled it
   size_t frames = 0;
   double distance_m = 0.0;
   LocalizationSummary summary;

@@ -194,7 +194,7 @@ Frame KittiRawReader::frame(size_t index) {
     throw std::runtime_error(
         files.image.string() + ": image is " + imageSizeText(rgb.width, rgb.height) + " but " +
         cam_to_cam_path_.string() + ": S_rect_02 says " + imageSizeText(cam.width, cam.height));
-  f.cameras.push_back(CameraFrame{std::move(rgb), Image()});
+  f.cameras.push_back(CameraFrame{std::move(rgb), Image(), std::nullopt});
 
   if (has_oxts_) {
     const Pose T_world_lidar = oxtsPose(files.oxts);

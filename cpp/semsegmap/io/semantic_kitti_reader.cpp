@@ -181,7 +181,7 @@ Frame SemanticKittiReader::frame(size_t index) {
                                imageSizeText(rgb.width, rgb.height) + " but " +
                                size_image_.string() + " is " +
                                imageSizeText(cam.width, cam.height) + " (image_2 has one size)");
-    f.cameras.push_back(CameraFrame{std::move(rgb), Image()});
+    f.cameras.push_back(CameraFrame{std::move(rgb), Image(), std::nullopt});
   }
   if (files.T_world_lidar) {
     f.T_world_base = *files.T_world_lidar;

@@ -25,6 +25,12 @@ struct FrontEndStages {
   std::shared_ptr<SegmentationNetwork> network;
   // T_odom_base of each frame from its scan; nullopt: the frames' own odometry.
   std::optional<OdometryConfig> lidar_odometry;
+  // How the network keeps to its budget (semantics.rate_hz, budget_cores): replayed on the
+  // data's clock (recordings: the same inputs give the same files), on its own thread beside the
+  // scans on the wall clock (a robot: semantics/live_labeler.h), or not at all (one scan that
+  // must be labelled: a relocalization).
+  enum class Labelling { kReplay, kLive, kEveryPicture };
+  Labelling labelling = Labelling::kReplay;
   bool any() const { return network != nullptr || lidar_odometry.has_value(); }
 };
 
@@ -44,7 +50,7 @@ class FramePreparation {
   // The frame the last prepare() returned, given the frame passed to it.
   const Frame& last(const Frame& given) const { return active_ ? prepared_ : given; }
   // How often the network ran; nullptr without one.
-  const LabelingStats* labeling() const { return labeler_ ? &labeler_->stats() : nullptr; }
+  std::optional<LabelingStats> labeling() const;
 
  private:
   bool active_ = false;

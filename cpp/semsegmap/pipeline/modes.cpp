@@ -189,6 +189,7 @@ MappingRun MappingSession::finish() {
   add(remaining, last);
   run_.map = builder_.build();
   run_.duplicates_removed = builder_.duplicatesRemoved();
+  run_.stats.labelling = pipeline_.labeling();
   return std::move(run_);
 }
 
@@ -414,8 +415,9 @@ std::optional<LocalizationRecord> LocalizationSession::relocalize(
   // No odometry: one scan's local map is in the scan's own frame (the frame's T_odom_base).
   DatasetInfo info = info_;
   info.has_odometry = true;
-  Pipeline scan(config_, info, PoseSource::kOdometry, describer_,
-                FrontEndStages{stages_.network, std::nullopt});
+  Pipeline scan(
+      config_, info, PoseSource::kOdometry, describer_,
+      FrontEndStages{stages_.network, std::nullopt, FrontEndStages::Labelling::kEveryPicture});
   const Pose T_local_base = scan.process(frame).T_local_base;
   const Outcome o = localizeFrame(scan, frame, T_local_base, 0.0, true, prior);
   if (!o.attempt.found) return std::nullopt;

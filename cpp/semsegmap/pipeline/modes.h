@@ -39,6 +39,8 @@ struct RunStats {
   StageTimes total;  // summed over frames; the pipeline alone, not reading or simulating data
   // RunOptions::stop ended the run before its last frame: `frames` are the frames done.
   bool interrupted = false;
+  // What the segmentation network did, when the run's stages had one.
+  std::optional<LabelingStats> labelling;
   double fps() const { return total.total() > 0 ? 1000.0 * frames / total.total() : 0.0; }
 };
 
@@ -157,7 +159,10 @@ class LocalizationSession {
   // relocalization then only searches the map within the prior's radius. Nothing: everywhere.
   void setPrior(std::optional<RelocalizationPrior> prior) { prior_ = std::move(prior); }
   const LocalizationRun& run() const { return run_; }
-  LocalizationRun take() { return std::move(run_); }
+  LocalizationRun take() {
+    run_.stats.labelling = pipeline_.labeling();
+    return std::move(run_);
+  }
   // One scan on its own, as a robot that wakes up has it: the frame through a fresh front end
   // (the network, no odometry: the scan's frame is its local map's) and the first frame's path of
   // `process` with relocalization on, whatever the config says; the map must store points. The

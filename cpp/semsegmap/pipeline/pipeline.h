@@ -74,7 +74,7 @@ class Pipeline {
   // with front-end stages its labelled and registered copy.
   const Frame& processedFrame(const Frame& given) const { return preparation_.last(given); }
   // How often the front end's network ran; nullptr without one.
-  const LabelingStats* labeling() const { return preparation_.labeling(); }
+  std::optional<LabelingStats> labeling() const { return preparation_.labeling(); }
   // End of the run: every segment still in the local map, finished; `descriptors` (optional)
   // receives their final descriptors when a describer is set.
   std::vector<Segment> finish(std::vector<Eigen::VectorXf>* descriptors = nullptr);

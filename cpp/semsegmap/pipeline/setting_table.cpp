@@ -362,8 +362,12 @@ std::vector<Setting> semanticsSettings() {
             "OpenCV threads while the network runs"),
       number(SEMSEGMAP_AT(semantics.rate_hz), kNotRecorded,
              "at most this many pictures a second per camera (0: every frame)"),
+      number(SEMSEGMAP_AT(semantics.budget_cores), kNotRecorded,
+             "the network's share of the cores on average (0: no limit)"),
       number(SEMSEGMAP_AT(semantics.tolerance_s), kNotRecorded,
              "a scan takes labels at most this much older"),
+      number(SEMSEGMAP_AT(semantics.latency_s), kNotRecorded,
+             "the network's time per picture when a recording replays the budget"),
       flag(SEMSEGMAP_AT(semantics.replace_dataset_labels), kNotRecorded,
            "run the network on pictures that have labels too"),
   };

@@ -1,8 +1,9 @@
 // The camera segmentation network (the paper's first step: "the color images are passed through
 // a semantic segmentation network"): a network exported to ONNX, run on the CPU through OpenCV's
 // DNN module, turns an RGB picture into a label image in the project's classes through a class
-// map. No network is shipped (none can be downloaded here); docs/real-data.md, "Semantics from a
-// network", says how to export one and which class map goes with it.
+// map. The one shipped network (models/semsegmap-seg.onnx, `semsegmap train-segmentation`) is
+// trained on the simulator and is for simulated data; docs/real-data.md, "Semantics from a
+// network", says how to export one for real pictures and which class map goes with it.
 #pragma once
 
 #include <array>
@@ -44,10 +45,18 @@ struct SemanticsConfig {
   bool bgr = false;  // the network takes BGR channels (Caffe and OpenCV-trained models)
   NetworkOutput output = NetworkOutput::kLogits;
   int threads = 2;  // OpenCV's threads while the network runs (given back after each picture)
-  // The network may run slower than the LiDAR: at most rate_hz per camera (0: every frame), each
-  // scan in between taking the camera's latest labels when they are at most tolerance_s older.
+  // The network on a budget (semantics/label_schedule.h): it labels at most rate_hz pictures a
+  // second per camera (0: no limit) and uses at most budget_cores of the machine's cores on
+  // average (0: no limit); a scan takes each camera's newest labels at most tolerance_s older
+  // than itself, carried by odometry, or none. All three 0 (with latency_s): every picture is
+  // labelled and every scan takes its own pictures' labels.
   double rate_hz = 0.0;
+  double budget_cores = 0.0;
   double tolerance_s = 0.5;
+  // A recording replays the budget deterministically with this as the network's time per picture
+  // (seconds on `threads` threads; measure it with BM_SegmentationNetwork), so that the same
+  // inputs give the same files. On a robot the network's own time counts instead.
+  double latency_s = 0.0;
   // Run the network on pictures that already have label images too (e.g. to measure a network
   // against the simulator's perfect labels); normally dataset labels are kept.
   bool replace_dataset_labels = false;

@@ -326,7 +326,8 @@ void checkSemanticsSettings(const std::filesystem::path& path, const SemanticsCo
   for (float s : c.std) check(s > 0, "std: must be positive");
   check((c.input_width > 0) == (c.input_height > 0),
         "input_width, input_height: give both (positive) or neither");
-  check(c.rate_hz >= 0 && c.tolerance_s >= 0, "rate_hz, tolerance_s: must not be negative");
+  check(c.rate_hz >= 0 && c.tolerance_s >= 0 && c.budget_cores >= 0 && c.latency_s >= 0,
+        "rate_hz, budget_cores, tolerance_s, latency_s: must not be negative");
 }
 
 }  // namespace

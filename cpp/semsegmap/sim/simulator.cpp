@@ -145,7 +145,7 @@ Frame Simulator::frame(size_t index) {
                                   lighting_, hashKeys(seed, c + 1));
     if (config_.label_noise > 0)
       r.label = applyLabelNoise(r.label, label_noise_, hashKeys(seed, c + 1, 0x6e6f697365));
-    f.cameras.push_back({std::move(r.rgb), std::move(r.label)});
+    f.cameras.push_back({std::move(r.rgb), std::move(r.label), std::nullopt});
   }
   return f;
 }
