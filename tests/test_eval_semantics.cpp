@@ -113,6 +113,26 @@ TEST(EvalSemantics, ClassesComeFromTheCamerasNotThePointLabels) {
   EXPECT_LT(e.per_frame.accuracy(), 0.5);
 }
 
+// The shipped network on its budget: the first scan has no labels yet (it counts as not
+// classified, instead of stopping the run), the others take earlier pictures' labels, carried by
+// odometry; what lands on the points is near what each picture's own labels give.
+TEST(EvalSemantics, ANetworkOnABudgetIsMeasuredScanByScan) {
+  DatasetOptions options;
+  options.semantics =
+      loadSemanticsConfig(fs::path(SEMSEGMAP_SOURCE_DIR) / "config" / "semantics-sim-network.yaml");
+  options.class_maps_dir = fs::path(SEMSEGMAP_SOURCE_DIR) / "config" / "class_maps";
+  const std::string spec = "sim:world=1,preset=tiny,frames=4";
+  auto budget = openDataset(spec, options);
+  const SemanticsEvaluation b = evaluateSemantics(*budget, simConfig());
+  ASSERT_EQ(b.frames.size(), 4u);
+  options.semantics.budget_cores = options.semantics.latency_s = 0;  // every picture, its own
+  auto every = openDataset(spec, options);
+  const SemanticsEvaluation e = evaluateSemantics(*every, simConfig());
+  EXPECT_LT(b.per_frame.classifiedShare(), e.per_frame.classifiedShare());
+  EXPECT_GT(b.per_frame.classifiedShare(), 0.4);
+  EXPECT_GT(b.per_frame.accuracy(), e.per_frame.accuracy() - 0.05);
+}
+
 // A stop request (Ctrl-C) between frames: the scores are those of the frames done, marked.
 TEST(EvalSemantics, AStopRequestEndsItBetweenFrames) {
   auto source = openDataset("sim:world=1,preset=tiny,frames=4");

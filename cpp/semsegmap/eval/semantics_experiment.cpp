@@ -86,7 +86,9 @@ std::vector<PointLabel> takeTruth(Frame& frame, const std::string& dataset) {
     throw std::runtime_error(where + " has " + std::to_string(frame.point_labels.size()) +
                              " ground-truth labels for " + std::to_string(frame.points.size()) +
                              " points");
-  bool labelled = false;
+  // A network on a budget may leave a scan without labels yet (Frame::camera_semantics): its
+  // points count as not classified.
+  bool labelled = frame.camera_semantics;
   for (const CameraFrame& c : frame.cameras) labelled |= !c.label.empty();
   if (!labelled)
     throw std::runtime_error(where +
