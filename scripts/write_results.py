@@ -270,6 +270,13 @@ BENCHMARKS = [
     ("BM_SegmentationNetwork/2", "the same, 2 threads", "", "ms"),
     ("BM_WholePipeline/0/0", "whole pipeline with the network on every picture", "", "Hz"),
     ("BM_WholePipeline/0/2", "the same, the network at 2 Hz per camera", "", "Hz"),
+    ("BM_ShippedSegmentationNetwork/1", "the project's network (models/semsegmap-seg.onnx), one "
+     "640x480 picture at 320x240, 1 thread", "<= 40 ms", "ms"),
+    ("BM_WholePipeline/0/1000", "whole pipeline, SemSegMap, with the project's network beside "
+     "the scans at its shipped budget (0.25 cores)", ">= 10 Hz", "Hz"),
+    ("BM_WholePipeline/1/1000", "the same, SegMap", ">= 10 Hz", "Hz"),
+    ("BM_WholePipeline/0/1001", "SemSegMap with the project's network on every picture, in the "
+     "scan loop", "", "Hz"),
     ("BM_OdometryOurs", "LiDAR odometry, KITTI HDL-64E scans, one core", ">= 20 Hz", "items"),
     ("BM_LocalizationQuery/10000", "localization query (100 segments, k = 16) against 10k "
      "segments", "<= 5 ms", "ms"),

@@ -79,6 +79,29 @@ def test_label_noise_table_has_a_row_per_level(tmp_path):
     assert rows[2:] == ["| 0 | 10 | 0 |", "| 3 | 7 | 0 |"]
 
 
+def test_label_rate_table_takes_each_kind_of_labels_from_a_file_of_several(tmp_path):
+    def labelled(run, config, n, labels, share=0.0):
+        return dict(localization_result(run, config, n), labels=labels,
+                    network_share_of_cores=share)
+    # The demo's file: perfect labels, then the network's; a rate run's file: the network's.
+    demo = localization_json(tmp_path, "demo", [
+        labelled("S2", "semsegmap", 30, "perfect"), labelled("S2", "segmap", 20, "perfect"),
+        labelled("S2", "semsegmap", 24, "network", 0.25),
+        labelled("S2", "segmap", 16, "network", 0.25)])
+    rate = localization_json(tmp_path, "rate", [
+        labelled("S2", "semsegmap", 9, "network,rate=1", 0.05),
+        labelled("S2", "segmap", 0, "network,rate=1", 0.05)])
+    rows = write_table(tmp_path, "label-rate", [
+        f"perfect={demo}", f"network at the shipped budget={demo}", f"network at 1 Hz={rate}"])
+    assert rows[0] == ("| camera labels | S2 semsegmap | S2 segmap | S2 lead | wrong "
+                       "| network cores |")
+    assert rows[2:] == ["| perfect | 30 | 20 | 1.50 | 0 | - |",
+                        "| network at the shipped budget | 24 | 16 | 1.50 | 0 | 0.25 |",
+                        "| network at 1 Hz | 9 | 0 | - | 0 | 0.05 |"]
+    # The label-noise table takes the perfect rows of a file with the network's too.
+    assert write_table(tmp_path, "label-noise", [f"0={demo}"])[2] == "| 0 | 30 | 20 | 0 |"
+
+
 def test_segmentation_table_has_the_change_against_the_paper(tmp_path):
     seg = tmp_path / "segmentation.json"
     seg.write_text(json.dumps({
