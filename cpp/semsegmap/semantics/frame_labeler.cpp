@@ -6,6 +6,21 @@
 
 namespace semsegmap {
 
+namespace {
+
+// The network on one picture, the run and its wall time counted in `stats`; `ms` is that time.
+Image runNetwork(const LabelFunction& network, const Image& rgb, const std::string& what,
+                 LabelingStats& stats, double& ms) {
+  const auto clock = std::chrono::steady_clock::now();
+  Image labels = network(rgb, what);
+  ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock).count();
+  stats.network_ms += ms;
+  ++stats.network_runs;
+  return labels;
+}
+
+}  // namespace
+
 std::vector<size_t> camerasToLabel(const Frame& frame, const SemanticsConfig& config,
                                    LabelingStats& stats) {
   std::vector<size_t> cameras;
@@ -66,12 +81,10 @@ void ReplayLabeler::advance(double t, bool inclusive, const std::string& what) {
     const double start = std::max({free_at_, next_start_, schedule_.pendingTime(*k)});
     if (inclusive ? start > t : start >= t) break;
     PendingPicture picture = schedule_.take(*k);
-    const auto clock = std::chrono::steady_clock::now();
-    Image labels = network_(picture.rgb, what + ", camera " + std::to_string(*k));
-    stats_.network_ms +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock).count();
-    ++stats_.network_runs;
-    stats_.busy_core_s += config_.latency_s * threads;
+    double ms = 0.0;
+    Image labels =
+        runNetwork(network_, picture.rgb, what + ", camera " + std::to_string(*k), stats_, ms);
+    stats_.busy_core_s += config_.latency_s * threads;  // replayed: the configured time counts
     free_at_ = start + config_.latency_s;
     next_start_ = start + cycle;
     schedule_.deliver(picture, std::move(labels), free_at_);
@@ -81,15 +94,12 @@ void ReplayLabeler::advance(double t, bool inclusive, const std::string& what) {
 void ReplayLabeler::labelEveryPicture(Frame& frame, const std::vector<size_t>& cameras,
                                       const std::string& what) {
   for (size_t k : cameras) {
-    const auto clock = std::chrono::steady_clock::now();
-    frame.cameras[k].label = network_(frame.cameras[k].rgb, what + ", camera " + std::to_string(k));
+    double ms = 0.0;
+    frame.cameras[k].label = runNetwork(network_, frame.cameras[k].rgb,
+                                        what + ", camera " + std::to_string(k), stats_, ms);
     frame.cameras[k].T_label_lidar.reset();
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock).count();
-    stats_.network_ms += ms;
     // Not replayed: the share of the cores is what the network took here, against the data's time.
     stats_.busy_core_s += ms * 1e-3 * std::max(1, config_.threads);
-    ++stats_.network_runs;
     ++stats_.own;
   }
 }
