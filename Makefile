@@ -22,8 +22,10 @@ build: setup
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# DEMO_ARGS: options of `semsegmap demo`, e.g. --preset tiny (CI: the same job on a smaller world).
+DEMO_ARGS ?=
 demo: build
-	./$(BUILD)/semsegmap demo --out demo_out
+	./$(BUILD)/semsegmap demo --out demo_out $(DEMO_ARGS)
 
 bench: build
 	./$(BUILD)/bench/semsegmap_bench

@@ -450,6 +450,9 @@ TEST(Cli, EvalLocalizationLabelsAreCheckedBeforeTheWork) {
       {"network,rate=abc", "--labels: rate=abc needs a positive number"},
       {"network,rate=-1", "--labels: rate=-1 needs a positive number"},
       {"network,speed=2", "--labels: unknown key 'speed=2'"},
+      {"perfect+netwrk", "--labels expects perfect or network"},
+      {"perfect+network,every+perfect", "--labels: 'perfect' is given twice"},
+      {"+", "--labels: no label pass given"},
   };
   for (const auto& [spec, message] : usage) {
     const Result r = run(std::string("eval localization --out o --labels ") + spec);

@@ -10,6 +10,7 @@
 #include "semsegmap/core/json.h"
 #include "semsegmap/eval/localization_metrics.h"
 #include "semsegmap/eval/report.h"
+#include "semsegmap/settings/config.h"
 #include "temp_dir.h"
 
 namespace semsegmap {
@@ -187,6 +188,49 @@ TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
     const std::string link = report.substr(at + 2, report.find(')', at) - at - 2);
     EXPECT_TRUE(std::filesystem::exists(out / link)) << link;
   }
+}
+
+// The demo's two halves on one rendering: a network's pass beside the simulator's labels gives,
+// file for file, what each pass gives alone, and says where its labels came from.
+TEST(LocalizationExperiment, PassesOnTheSameFramesGiveWhatEachGivesAlone) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  SEMSEGMAP_SKIP_WITHOUT_TORCH();
+  TempDir tmp;
+  LabelPass network;
+  network.labels = "network";
+  network.network = loadSemanticsConfig(kSource + "/config/semantics-sim-network.yaml");
+  network.dir = "network";
+  LocalizationExperimentConfig c;
+  c.preset = "tiny";
+  c.max_frames = 30;
+  c.query_runs = {"S2"};
+  c.configs = {bothConfigs()[0]};
+  c.class_maps_dir = kSource + "/config/class_maps";
+  c.label_passes = {LabelPass{}, network};
+  const LocalizationExperiment both = evaluateLocalization(c, tmp.path() / "both");
+  c.label_passes = {LabelPass{}};
+  const LocalizationExperiment perfect = evaluateLocalization(c, tmp.path() / "perfect");
+  network.dir = "";
+  c.label_passes = {network};
+  const LocalizationExperiment alone = evaluateLocalization(c, tmp.path() / "network");
+
+  ASSERT_EQ(both.results.size(), 2u);
+  EXPECT_EQ(both.results[0].labels, "perfect");
+  EXPECT_EQ(both.results[1].labels, "network");
+  EXPECT_EQ(both.results[1].dir, std::filesystem::path("network") / "semsegmap_S2");
+  EXPECT_GT(both.results[1].labelling.network_runs, 0u);
+  EXPECT_EQ(perfect.results[0].labelling.network_runs, 0u);
+  const auto same = [&](const std::filesystem::path& a, const std::filesystem::path& b) {
+    EXPECT_EQ(readFileBytes(tmp.path() / a), readFileBytes(tmp.path() / b)) << a << " " << b;
+  };
+  same("both/maps/semsegmap.map", "perfect/maps/semsegmap.map");
+  same("both/network/maps/semsegmap.map", "network/maps/semsegmap.map");
+  same("both/semsegmap_S2/localizations.csv", "perfect/semsegmap_S2/localizations.csv");
+  same("both/network/semsegmap_S2/localizations.csv", "network/semsegmap_S2/localizations.csv");
+  EXPECT_NE(readFileBytes(tmp.path() / "both/maps/semsegmap.map"),
+            readFileBytes(tmp.path() / "both/network/maps/semsegmap.map"));
+  EXPECT_EQ(both.results[1].labelling.network_runs, alone.results[0].labelling.network_runs);
+  EXPECT_GT(both.results[0].map_segments, 0u);
 }
 
 }  // namespace

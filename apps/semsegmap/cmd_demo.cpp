@@ -47,22 +47,15 @@ std::string writeDemoView(const LocalizationExperiment& e, const std::filesystem
 }
 
 // The same runs with the camera labels of the shipped segmentation network at its shipped
-// budget instead of the simulator's perfect ones (the paper's whole pipeline): their rows join
-// the table, their files go to out/network/.
-void addNetworkRows(LocalizationExperiment& e, LocalizationExperimentConfig config,
-                    const std::filesystem::path& out, StageProgress& progress) {
-  config.labels = "network";
-  config.network = loadSemanticsConfig(shippedFile("config/semantics-sim-network.yaml"));
+// budget as well as the simulator's perfect ones (the paper's whole pipeline), on the same
+// rendered frames: their rows join the table, their files go to out/network/.
+void addNetworkPass(LocalizationExperimentConfig& config) {
+  LabelPass pass;
+  pass.labels = "network";
+  pass.network = loadSemanticsConfig(shippedFile("config/semantics-sim-network.yaml"));
+  pass.dir = "network";
+  config.label_passes.push_back(std::move(pass));
   config.class_maps_dir = shippedFile("config/class_maps");
-  std::cout << "and again with the shipped segmentation network's labels ("
-            << config.network.budget_cores << " cores, at most " << config.network.rate_hz
-            << " pictures a second per camera)\n";
-  LocalizationExperiment n = evaluateLocalization(config, out / "network", std::ref(progress));
-  for (LocalizationResult& r : n.results) {
-    r.dir = std::filesystem::path("network") / r.dir;
-    e.results.push_back(std::move(r));
-  }
-  e.interrupted = n.interrupted;
 }
 
 int runDemo(const CliArgs& a) {
@@ -78,17 +71,25 @@ int runDemo(const CliArgs& a) {
     // Their learned descriptors need libtorch: a build without it says so before it starts.
     requireDescriberBuilt(config.configs.back().config.descriptor, name);
   }
+  addNetworkPass(config);
   std::filesystem::create_directories(out);
 
+  const SemanticsConfig& network = config.label_passes.back().network;
   std::cout << "semsegmap demo: world " << config.world_seed << " (" << config.preset
-            << "), map S0, localize S2 (sunny) and S3 (sunrise) with SemSegMap and SegMap\n";
+            << "), map S0, localize S2 (sunny) and S3 (sunrise) with SemSegMap and SegMap,\n"
+            << "with the simulator's perfect camera labels and with the shipped segmentation "
+               "network's (within "
+            << network.budget_cores << " of a core"
+            << (network.rate_hz > 0
+                    ? ", at most " + std::to_string(network.rate_hz) + " pictures a second a camera"
+                    : "")
+            << ")\n";
   viz::writeSimOverview(sim::worldPreset(config.preset, config.world_seed), out / "overview.png");
   config.stop = stopToken();
   StageProgress progress;
   LocalizationExperiment e = evaluateLocalization(config, out, std::ref(progress));
   // Ctrl-C before the first frame: nothing worth keeping (main removes the folder's new files).
   if (e.interrupted && !progress.started()) return interruptedStages("demo", progress, "");
-  if (!e.interrupted) addNetworkRows(e, config, out, progress);
   writeLocalizationFiles(e, out);
   std::cout << "\n" << localizationTable(e) << "\n";
 

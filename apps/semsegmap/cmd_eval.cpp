@@ -1,11 +1,13 @@
 // semsegmap eval <experiment>: the paper's experiments as commands (eval/*_experiment.h), each
 // printing its table and writing JSON and pictures; `eval paper` runs all three and writes
 // report.md.
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "cli_args.h"
@@ -83,24 +85,25 @@ DescriptorExperimentConfig descriptorConfig(const CliArgs& a) {
   return c;
 }
 
-// --labels perfect | network[,rate=R][,budget=C][,every][,config=FILE]: the simulator's labels,
-// or the shipped segmentation network's (config/semantics-sim-network.yaml, or FILE's
-// semantics: section) at its shipped budget, at R pictures a second per camera, within C cores,
-// or on every picture.
-void setLabels(LocalizationExperimentConfig& c, const std::string& spec) {
-  c.labels = spec;
-  if (spec == "perfect") return;
+// One pass of --labels: perfect | network[,rate=R][,budget=C][,every][,config=FILE]: the
+// simulator's labels, or the shipped segmentation network's (config/semantics-sim-network.yaml,
+// or FILE's semantics: section) at its shipped budget, at R pictures a second per camera, within
+// C cores, or on every picture.
+LabelPass labelPass(const std::string& spec) {
+  LabelPass pass;
+  pass.labels = spec;
+  if (spec == "perfect") return pass;
   const std::vector<std::string> keys = splitList(spec);
   if (keys.empty() || keys.front() != "network")
     throw UsageError(
         "--labels expects perfect or network[,rate=R][,budget=C][,every]"
-        "[,config=FILE], got '" +
+        "[,config=FILE], joined by +, got '" +
         spec + "'");
   std::filesystem::path file = shippedFile("config/semantics-sim-network.yaml");
   for (size_t i = 1; i < keys.size(); ++i)
     if (keys[i].rfind("config=", 0) == 0) file = keys[i].substr(7);
-  c.network = loadSemanticsConfig(file);
-  c.class_maps_dir = shippedFile("config/class_maps");
+  SemanticsConfig& n = pass.network;
+  n = loadSemanticsConfig(file);
   for (size_t i = 1; i < keys.size(); ++i) {
     const std::string& k = keys[i];
     const auto number = [&](size_t at) {
@@ -111,17 +114,40 @@ void setLabels(LocalizationExperimentConfig& c, const std::string& spec) {
       return v;
     };
     if (k.rfind("rate=", 0) == 0) {
-      c.network.rate_hz = number(5);
-      c.network.budget_cores = 0;  // the rate alone limits the network
+      n.rate_hz = number(5);
+      n.budget_cores = 0;  // the rate alone limits the network
     } else if (k.rfind("budget=", 0) == 0) {
-      c.network.budget_cores = number(7);
+      n.budget_cores = number(7);
     } else if (k == "every") {
-      c.network.rate_hz = c.network.budget_cores = c.network.latency_s = 0;
+      n.rate_hz = n.budget_cores = n.latency_s = 0;
     } else if (k.rfind("config=", 0) != 0) {
       throw UsageError("--labels: unknown key '" + k + "' (rate=R, budget=C, every, config=FILE)");
     }
   }
-  checkReplayable(c.network, file.string());
+  checkReplayable(n, file.string());
+  return pass;
+}
+
+// --labels A+B+...: a pass per spec on the same rendered frames; the first pass's files go into
+// the output folder, each other's into a folder named after its spec (network,rate=2 ->
+// network_rate-2).
+void setLabels(LocalizationExperimentConfig& c, const std::string& specs) {
+  c.label_passes.clear();
+  std::set<std::string> seen;
+  for (const std::string& spec : splitList(specs, '+')) {
+    if (!seen.insert(spec).second) throw UsageError("--labels: '" + spec + "' is given twice");
+    LabelPass pass = labelPass(spec);
+    if (!c.label_passes.empty()) {
+      std::string dir = spec;
+      std::replace(dir.begin(), dir.end(), ',', '_');
+      std::replace(dir.begin(), dir.end(), '=', '-');
+      std::replace(dir.begin(), dir.end(), '/', '-');
+      pass.dir = dir;
+    }
+    c.label_passes.push_back(std::move(pass));
+  }
+  if (c.label_passes.empty()) throw UsageError("--labels: no label pass given");
+  c.class_maps_dir = shippedFile("config/class_maps");
 }
 
 LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
@@ -139,7 +165,8 @@ LocalizationExperimentConfig localizationConfig(const CliArgs& a) {
   c.label_noise = static_cast<int>(a.getCount("label-noise"));
   if (c.label_noise > 3) throw UsageError("--label-noise is 0 (perfect labels) to 3");
   setLabels(c, a.get("labels"));
-  if (c.label_noise > 0 && !c.network.model.empty())
+  if (c.label_noise > 0 && std::any_of(c.label_passes.begin(), c.label_passes.end(),
+                                       [](const LabelPass& p) { return !p.network.model.empty(); }))
     throw UsageError(
         "--label-noise and --labels network: the network's labels replace the "
         "simulator's, noisy or not; give one of them");
@@ -269,7 +296,8 @@ const OptionSpec kLabels{
     "labels", Value::kText, "SPEC", "perfect",
     "camera labels: perfect (the simulator's), or network[,rate=R][,budget=C][,every]"
     "[,config=FILE]: the shipped segmentation network's on its budget, at R pictures a second "
-    "per camera, within C cores, or on every picture"};
+    "per camera, within C cores, or on every picture; several joined by + run on the same "
+    "frames"};
 const OptionSpec kRig{"rig", Value::kText, "KEYS", "",
                       "simulator keys for every run's rig, e.g. lidar=hdl64,cameras=front"};
 const OptionSpec kQueryOdometry{

@@ -7,11 +7,11 @@
 
 namespace semsegmap::app {
 
-std::vector<std::string> splitList(const std::string& s) {
+std::vector<std::string> splitList(const std::string& s, char separator) {
   std::vector<std::string> out;
   std::stringstream ss(s);
   std::string item;
-  while (std::getline(ss, item, ','))
+  while (std::getline(ss, item, separator))
     if (!item.empty()) out.push_back(item);
   return out;
 }

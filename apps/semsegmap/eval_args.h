@@ -9,7 +9,8 @@
 
 namespace semsegmap::app {
 
-std::vector<std::string> splitList(const std::string& s);
+// The non-empty items of a list separated by `separator`.
+std::vector<std::string> splitList(const std::string& s, char separator = ',');
 
 // --configs: SemSegMap first, the SegMap baseline second. The default list names shipped
 // configs; a list the user types names their own files.

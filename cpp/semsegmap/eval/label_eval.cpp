@@ -10,12 +10,6 @@
 
 namespace semsegmap {
 
-namespace {
-constexpr size_t kIds = 256;
-}
-
-LabelScores::LabelScores() : confusion_(kIds * kIds, 0) {}
-
 void LabelScores::add(const Image& truth, const Image& predicted) {
   if (truth.channels != 1 || predicted.channels != 1 || truth.width != predicted.width ||
       truth.height != predicted.height)
@@ -23,47 +17,41 @@ void LabelScores::add(const Image& truth, const Image& predicted) {
                                 std::to_string(truth.height) + " and " +
                                 std::to_string(predicted.width) + "x" +
                                 std::to_string(predicted.height) + " cannot be compared");
+  // Counted densely over the picture's 8-bit ids first, then folded into the sparse matrix.
+  std::vector<size_t> counts(256 * 256, 0);
   for (size_t i = 0; i < truth.data.size(); ++i)
-    if (truth.data[i] != cls::kUnknown) ++confusion_[truth.data[i] * kIds + predicted.data[i]];
+    if (truth.data[i] != cls::kUnknown) ++counts[truth.data[i] * 256 + predicted.data[i]];
+  for (size_t k = 0; k < counts.size(); ++k)
+    confusion_.add(static_cast<ClassId>(k / 256), static_cast<ClassId>(k % 256), counts[k]);
 }
 
 LabelScores& LabelScores::operator+=(const LabelScores& o) {
-  for (size_t i = 0; i < confusion_.size(); ++i) confusion_[i] += o.confusion_[i];
+  confusion_ += o.confusion_;
   return *this;
 }
 
 size_t LabelScores::truthPixels(ClassId c) const {
-  size_t n = 0;
-  for (size_t p = 0; p < kIds && c < kIds; ++p) n += confusion_[c * kIds + p];
-  return n;
+  return confusion_.truthCount(c);
 }
 
 size_t LabelScores::labelledPixels() const {
-  size_t n = 0;
-  for (size_t v : confusion_) n += v;
-  return n;
+  return confusion_.total();
 }
 
 double LabelScores::pixelAccuracy() const {
-  size_t correct = 0;
-  for (size_t c = 0; c < kIds; ++c) correct += confusion_[c * kIds + c];
   const size_t all = labelledPixels();
-  return all ? static_cast<double>(correct) / all : 0.0;
+  return all ? static_cast<double>(confusion_.correct()) / static_cast<double>(all) : 0.0;
 }
 
 double LabelScores::iou(ClassId c) const {
-  if (c >= kIds) return -1;
-  size_t predicted = 0;
-  for (size_t t = 0; t < kIds; ++t) predicted += confusion_[t * kIds + c];
-  const size_t tp = confusion_[c * kIds + c], truth = truthPixels(c);
-  const size_t union_ = truth + predicted - tp;
-  return union_ ? static_cast<double>(tp) / union_ : -1.0;
+  return confusion_.iou(c);
 }
 
 std::vector<ClassId> LabelScores::truthClasses(bool with_sky) const {
   std::vector<ClassId> out;
-  for (ClassId c = 1; c < kIds; ++c)
-    if (truthPixels(c) > 0 && (with_sky || c != cls::kSky)) out.push_back(c);
+  for (int c = 1; c < 256; ++c)
+    if (truthPixels(static_cast<ClassId>(c)) > 0 && (with_sky || c != cls::kSky))
+      out.push_back(static_cast<ClassId>(c));
   return out;
 }
 

@@ -12,16 +12,16 @@
 #include "semsegmap/core/class_table.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/core/stop_token.h"
+#include "semsegmap/eval/confusion_matrix.h"
 #include "semsegmap/semantics/segmentation_network.h"
 #include "semsegmap/viz/label_comparison.h"
 
 namespace semsegmap {
 
-// A confusion matrix over class ids 0..255 (truth x predicted); pixels whose truth is unknown
-// (0) are left out of every count.
+// Pixels of label images counted by (truth, predicted) class; pixels whose truth is unknown (0)
+// are left out of every count.
 class LabelScores {
  public:
-  LabelScores();
   // Throws std::invalid_argument when the two differ in size or are not 1-channel.
   void add(const Image& truth, const Image& predicted);
   LabelScores& operator+=(const LabelScores& o);
@@ -34,7 +34,7 @@ class LabelScores {
   std::vector<ClassId> truthClasses(bool with_sky) const;
 
  private:
-  std::vector<size_t> confusion_;  // 256 x 256
+  ConfusionMatrix confusion_;
 };
 
 struct LabelEvalConfig {

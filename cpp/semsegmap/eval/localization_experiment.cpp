@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -19,33 +20,63 @@ namespace semsegmap {
 
 namespace {
 
-// How every run is opened: with the network that labels its pictures, when there is one.
-DatasetOptions runOptions(const LocalizationExperimentConfig& cfg) {
-  DatasetOptions options;
-  if (cfg.network.model.empty()) return options;
-  options.semantics = cfg.network;
-  options.semantics.replace_dataset_labels = true;  // the simulator's are perfect
-  options.class_maps_dir = cfg.class_maps_dir;
-  return options;
+using PassLabelers = std::vector<std::unique_ptr<ReplayLabeler>>;
+
+// Each pass's labeler: none for the simulator's labels; else its network, loaded and checked
+// against the run's cameras before any frame is read.
+PassLabelers passLabelers(const LocalizationExperimentConfig& cfg, const DatasetInfo& info) {
+  PassLabelers labelers;
+  for (const LabelPass& pass : cfg.label_passes) {
+    if (pass.network.model.empty()) {
+      labelers.push_back(nullptr);
+      continue;
+    }
+    SemanticsConfig network = pass.network;
+    network.replace_dataset_labels = true;  // the simulator's are perfect
+    labelers.push_back(std::make_unique<ReplayLabeler>(
+        loadSegmentationNetwork(network, info, cfg.class_maps_dir), info.rig.T_base_lidar));
+  }
+  return labelers;
 }
 
-// The map run, rendered once for every configuration; each map is saved into out/maps/ (when
-// interrupted, the map of the frames done: a whole map of a shorter run).
-std::vector<BuiltMap> buildMaps(LocalizationExperiment& e,
-                                const std::vector<std::shared_ptr<Describer>>& describers,
-                                const std::filesystem::path& out,
-                                const ExperimentProgress& progress) {
+// Hands each pass its frame: the rendered one, or a copy that the pass's network labels.
+void feedPasses(const Frame& frame, const PassLabelers& labelers,
+                const std::function<void(size_t pass, const Frame&)>& use) {
+  for (size_t p = 0; p < labelers.size(); ++p) {
+    if (!labelers[p]) {
+      use(p, frame);
+      continue;
+    }
+    Frame labelled = frame;
+    labelers[p]->label(labelled, "frame " + std::to_string(frame.index));
+    use(p, labelled);
+  }
+}
+
+// The map run, rendered once for every pass and configuration; each map is saved into
+// out/<pass dir>/maps/ (when interrupted, the map of the frames done: a whole map of a shorter
+// run). Indexed [pass][configuration].
+std::vector<std::vector<BuiltMap>> buildMaps(
+    LocalizationExperiment& e, const std::vector<std::shared_ptr<Describer>>& describers,
+    const std::filesystem::path& out, const ExperimentProgress& progress) {
   const LocalizationExperimentConfig& cfg = e.config;
   auto source = openDataset(simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset,
-                                             cfg.max_frames, cfg.label_noise, cfg.rig),
-                            runOptions(cfg));
-  auto sessions =
-      mappingSessions(cfg.configs, source->info(), describers, cfg.picture_points_per_segment);
+                                             cfg.max_frames, cfg.label_noise, cfg.rig));
+  const PassLabelers labelers = passLabelers(cfg, source->info());
+  std::vector<std::vector<std::unique_ptr<MappingSession>>> sessions;
+  for (size_t p = 0; p < labelers.size(); ++p)
+    sessions.push_back(
+        mappingSessions(cfg.configs, source->info(), describers, cfg.picture_points_per_segment));
   e.interrupted =
       !forEachFrame(*source, "map " + cfg.map_run, progress, cfg.stop, [&](const Frame& frame) {
-        for (auto& s : sessions) s->process(frame);
+        feedPasses(frame, labelers, [&](size_t p, const Frame& f) {
+          for (auto& s : sessions[p]) s->process(f);
+        });
       });
-  return finishMaps(sessions, cfg.configs, out);
+  std::vector<std::vector<BuiltMap>> maps;
+  for (size_t p = 0; p < sessions.size(); ++p)
+    maps.push_back(finishMaps(sessions[p], cfg.configs, out / cfg.label_passes[p].dir));
+  return maps;
 }
 
 LocalizationResult resultOf(const LocalizationExperiment& e, const NamedConfig& config,
@@ -85,23 +116,23 @@ LocalizationResult resultOf(const LocalizationExperiment& e, const NamedConfig& 
 // What one configuration's run leaves behind in out/<r.dir>.
 void writeRunFiles(const LocalizationExperimentConfig& cfg, const NamedConfig& config,
                    const LocalizationRun& run, const BuiltMap& map, const LocalizationResult& r,
-                   const std::filesystem::path& out) {
+                   const std::filesystem::path& out, const LabelPass& pass) {
   SummaryContext context;
   context.dataset = r.dataset;
-  context.map = builtMapPath(out, config).string();
+  context.map = builtMapPath(out / pass.dir, config).string();
   context.config = config.path.string();
   writeLocalizationRunFiles(
       out / r.dir, run, map, context,
       r.run + " (" + r.dataset + ") against the " + cfg.map_run + " map, " + config.name);
 }
 
-// One query run, rendered once for every configuration.
+// One query run, rendered once for every pass and configuration.
 void localizeRun(LocalizationExperiment& e, const std::string& run_name,
                  const std::vector<std::shared_ptr<Describer>>& describers,
-                 const std::vector<BuiltMap>& maps, const std::filesystem::path& out,
+                 const std::vector<std::vector<BuiltMap>>& maps, const std::filesystem::path& out,
                  const ExperimentProgress& progress) {
   const LocalizationExperimentConfig& cfg = e.config;
-  DatasetOptions options = runOptions(cfg);
+  DatasetOptions options;
   if (cfg.lidar_odometry) {
     options.odometry = "lidar";
     options.lidar_odometry = cfg.odometry;
@@ -109,23 +140,31 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
   auto source = openDataset(simulatedRunSpec(cfg.world_seed, run_name, cfg.preset, cfg.max_frames,
                                              cfg.label_noise, cfg.rig),
                             options);
-  std::vector<std::unique_ptr<LocalizationSession>> sessions;
-  for (size_t c = 0; c < cfg.configs.size(); ++c)
-    sessions.push_back(std::make_unique<LocalizationSession>(cfg.configs[c].config, source->info(),
-                                                             maps[c].map, describers[c]));
+  const PassLabelers labelers = passLabelers(cfg, source->info());
+  std::vector<std::vector<std::unique_ptr<LocalizationSession>>> sessions(labelers.size());
+  for (size_t p = 0; p < labelers.size(); ++p)
+    for (size_t c = 0; c < cfg.configs.size(); ++c)
+      sessions[p].push_back(std::make_unique<LocalizationSession>(
+          cfg.configs[c].config, source->info(), maps[p][c].map, describers[c]));
   e.interrupted =
       !forEachFrame(*source, "localize " + run_name, progress, cfg.stop, [&](const Frame& frame) {
-        for (auto& s : sessions) s->process(frame);
+        feedPasses(frame, labelers, [&](size_t p, const Frame& f) {
+          for (auto& s : sessions[p]) s->process(f);
+        });
       });
-  for (size_t c = 0; c < cfg.configs.size(); ++c) {
-    LocalizationRun run = sessions[c]->take();
-    run.stats.interrupted = e.interrupted;  // its summary.json says the frames are those done
-    LocalizationResult r = resultOf(e, cfg.configs[c], run_name, run, maps[c]);
-    r.dataset = source->info().name;
-    r.labels = cfg.labels;
-    if (const FrameLabeler* labeler = labelerOf(*source)) r.labelling = labeler->stats();
-    writeRunFiles(cfg, cfg.configs[c], run, maps[c], r, out);
-    e.results.push_back(std::move(r));
+  for (size_t p = 0; p < labelers.size(); ++p) {
+    const LabelPass& pass = cfg.label_passes[p];
+    for (size_t c = 0; c < cfg.configs.size(); ++c) {
+      LocalizationRun run = sessions[p][c]->take();
+      run.stats.interrupted = e.interrupted;  // its summary.json says the frames are those done
+      LocalizationResult r = resultOf(e, cfg.configs[c], run_name, run, maps[p][c]);
+      r.dataset = source->info().name;
+      r.labels = pass.labels;
+      r.dir = pass.dir / r.dir;
+      if (labelers[p]) r.labelling = labelers[p]->stats();
+      writeRunFiles(cfg, cfg.configs[c], run, maps[p][c], r, out, pass);
+      e.results.push_back(std::move(r));
+    }
   }
 }
 
@@ -202,11 +241,14 @@ LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& 
   LocalizationExperiment e;
   e.config = cfg;
   for (int i = 0; i <= 100; ++i) e.thresholds.push_back(cfg.wrong_m * i / 100.0);
-  std::filesystem::create_directories(out / "maps");
+  for (const LabelPass& pass : cfg.label_passes)
+    std::filesystem::create_directories(out / pass.dir / "maps");
   // Models load first: a missing one fails before minutes of simulation.
   std::vector<std::shared_ptr<Describer>> describers;
   for (const NamedConfig& c : cfg.configs) describers.push_back(makeDescriber(c.config.descriptor));
-  const std::vector<BuiltMap> maps = buildMaps(e, describers, out, progress);
+  if (cfg.label_passes.empty())
+    throw std::invalid_argument("the localization experiment needs at least one label pass");
+  const std::vector<std::vector<BuiltMap>> maps = buildMaps(e, describers, out, progress);
   for (const std::string& run_name : cfg.query_runs) {
     if (e.interrupted) break;  // no run starts after the stop request
     localizeRun(e, run_name, describers, maps, out, progress);
@@ -220,13 +262,16 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
   j["preset"] = e.config.preset;
   j["map_run"] = e.config.map_run;
   j["label_noise"] = e.config.label_noise;
-  j["labels"] = e.config.labels;
-  if (!e.config.network.model.empty()) {
-    j["network"] = {{"model", e.config.network.model},
-                    {"rate_hz", e.config.network.rate_hz},
-                    {"budget_cores", e.config.network.budget_cores},
-                    {"latency_s", e.config.network.latency_s},
-                    {"tolerance_s", e.config.network.tolerance_s}};
+  j["label_passes"] = nlohmann::ordered_json::array();
+  for (const LabelPass& pass : e.config.label_passes) {
+    nlohmann::ordered_json p = {{"labels", pass.labels}, {"dir", pass.dir.string()}};
+    if (!pass.network.model.empty())
+      p["network"] = {{"model", pass.network.model},
+                      {"rate_hz", pass.network.rate_hz},
+                      {"budget_cores", pass.network.budget_cores},
+                      {"latency_s", pass.network.latency_s},
+                      {"tolerance_s", pass.network.tolerance_s}};
+    j["label_passes"].push_back(std::move(p));
   }
   j["rig"] = e.config.rig;
   j["query_odometry"] = e.config.lidar_odometry ? "lidar" : "simulated";

@@ -15,6 +15,16 @@
 
 namespace semsegmap {
 
+// Where the camera labels of one pass over the runs come from.
+struct LabelPass {
+  std::string labels = "perfect";  // for the files and tables: "network", "network,rate=2"
+  // This segmentation network's labels replace the simulator's in every run (map and queries),
+  // within the budget of its settings (replayed on the data's clock); the same labels reach
+  // every configuration. Empty model: the simulator's labels.
+  SemanticsConfig network;
+  std::filesystem::path dir;  // the pass's maps and runs, under the output folder ("": in it)
+};
+
 struct LocalizationExperimentConfig {
   uint64_t world_seed = 1;
   std::string preset = "full";  // sim::worldPreset
@@ -23,13 +33,10 @@ struct LocalizationExperimentConfig {
   size_t max_frames = 0;  // per run; 0: all
   // Camera labels of every run as a segmentation network's (sim/label_noise.h): 0 perfect.
   int label_noise = 0;
-  // Camera labels of every run (map and queries) from this segmentation network instead of the
-  // simulator's, within the budget of its settings (replayed on the data's clock); the same
-  // labels reach every configuration. Empty model: the simulator's labels. `labels` says which,
-  // for the files and tables ("perfect", "network", "network,rate=2").
-  SemanticsConfig network;
-  std::filesystem::path class_maps_dir;  // the shipped class maps, for network.class_map
-  std::string labels = "perfect";
+  // Every pass runs every configuration on the very same rendered frames: a network's pass
+  // labels its own copy of each frame, so the renderer (most of a frame's time) runs once.
+  std::vector<LabelPass> label_passes = {LabelPass{}};
+  std::filesystem::path class_maps_dir;  // the shipped class maps, for a network's class_map
   // Simulator keys appended to every run's spec: the rig, e.g. "lidar=hdl64,cameras=front".
   std::string rig;
   // The query runs' odometry from LiDAR odometry on their scans (odometry/), with these
@@ -48,7 +55,7 @@ struct LocalizationExperimentConfig {
 
 struct LocalizationResult {  // one configuration on one query run
   std::string config, descriptor, fingerprint, run, dataset;
-  std::string labels;       // LocalizationExperimentConfig::labels
+  std::string labels;       // LabelPass::labels
   LabelingStats labelling;  // of the query run, when a network labelled it
   size_t frames = 0;
   double distance_m = 0.0;
@@ -67,7 +74,7 @@ struct LocalizationResult {  // one configuration on one query run
 
 struct LocalizationExperiment {
   LocalizationExperimentConfig config;
-  std::vector<LocalizationResult> results;  // query run major, then configuration
+  std::vector<LocalizationResult> results;  // query run major, then pass, then configuration
   std::vector<double> thresholds;           // of the cumulative curves, m
   // LocalizationExperimentConfig::stop ended it early: `results` hold the query runs done, the
   // last of them over its frames done (none when the stop came while mapping).

@@ -127,10 +127,10 @@ std::string localizationSection(const LocalizationExperiment& e) {
     << " m. Recall: the fraction of metres driven after which the robot had a localization "
        "within "
     << e.config.correct_m << " m in the last " << e.config.recall_window_m
-    << " m. Hz: the whole pipeline per frame on this machine, rendering excluded; both "
-       "configurations' pipelines alternate on every frame next to the renderer, so this is "
-       "below what one pipeline alone reaches (the README's benchmarks). Paper: the paper's "
-       "Table I count for the same run and method.\n\n"
+    << " m. Hz: the whole pipeline per frame on this machine, rendering excluded; every "
+       "configuration's pipeline (with each kind of camera labels) alternates on every frame "
+       "next to the renderer, so this is below what one pipeline alone reaches (the README's "
+       "benchmarks). Paper: the paper's Table I count for the same run and method.\n\n"
     << localizationTable(e) << "\n"
     << localizationVerdict(e) << "\n"
     << (e.results.empty() ? "" : "![accuracy](localization_accuracy.png)\n\n");

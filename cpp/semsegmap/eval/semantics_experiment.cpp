@@ -16,22 +16,15 @@ void SemanticScores::add(ClassId truth, bool has_class, ClassId predicted) {
   ++points;
   if (!has_class) return;
   ++classified;
-  if (predicted == truth) {
-    ++correct;
-    ++true_positives[truth];
-    return;
-  }
-  ++false_positives[predicted];
-  ++false_negatives[truth];
+  correct += predicted == truth;
+  confusion.add(truth, predicted);
 }
 
 SemanticScores& SemanticScores::operator+=(const SemanticScores& o) {
   points += o.points;
   classified += o.classified;
   correct += o.correct;
-  for (const auto& [id, n] : o.true_positives) true_positives[id] += n;
-  for (const auto& [id, n] : o.false_positives) false_positives[id] += n;
-  for (const auto& [id, n] : o.false_negatives) false_negatives[id] += n;
+  confusion += o.confusion;
   return *this;
 }
 
@@ -39,11 +32,6 @@ namespace {
 
 double ratio(size_t a, size_t b) {
   return b == 0 ? 0.0 : static_cast<double>(a) / b;
-}
-
-size_t countOf(const std::map<ClassId, size_t>& m, ClassId id) {
-  const auto it = m.find(id);
-  return it == m.end() ? 0 : it->second;
 }
 
 }  // namespace
@@ -59,9 +47,7 @@ double SemanticScores::correctShare() const {
 }
 
 double SemanticScores::iou(ClassId id) const {
-  const size_t tp = countOf(true_positives, id);
-  const size_t all = tp + countOf(false_positives, id) + countOf(false_negatives, id);
-  return all == 0 ? -1.0 : static_cast<double>(tp) / all;
+  return confusion.iou(id);
 }
 
 namespace {

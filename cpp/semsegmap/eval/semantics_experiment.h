@@ -6,13 +6,13 @@
 
 #include <cstddef>
 #include <functional>
-#include <map>
 #include <string>
 #include <vector>
 
 #include "semsegmap/core/frame_source.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/core/stop_token.h"
+#include "semsegmap/eval/confusion_matrix.h"
 #include "semsegmap/pipeline/pipeline_config.h"
 
 namespace semsegmap {
@@ -23,9 +23,7 @@ struct SemanticScores {
   size_t points = 0;      // points with a ground-truth class
   size_t classified = 0;  // of them, points a camera gave a class (has_class, or a voxel's votes)
   size_t correct = 0;     // of those, points whose class is the ground truth's
-  // Per class id, over the classified points: true positives, false positives (predicted as the
-  // class, truth another) and false negatives (truth the class, predicted another).
-  std::map<ClassId, size_t> true_positives, false_positives, false_negatives;
+  ConfusionMatrix confusion;  // of the classified points
 
   void add(ClassId truth, bool has_class, ClassId predicted);
   SemanticScores& operator+=(const SemanticScores& o);
