@@ -162,8 +162,15 @@ def configs_table(inputs):
 def results_with_labels(path, wanted):
     """The results of a localization.json whose camera labels are `wanted` ("perfect",
     "network", ...), when it holds several kinds (the demo: perfect, then the network's); a file
-    of one kind gives all of its results."""
+    of one kind gives all of its results. FILE#DIR takes the label pass whose files are in DIR
+    (eval localization --labels A+B puts each pass but the first in a folder of its own)."""
+    path, _, pass_dir = path.partition("#")
     results = load_localization(path)["results"]
+    if pass_dir:
+        found = [r for r in results if r["dir"].startswith(pass_dir + "/")]
+        if not found:
+            fail(f"{path}: has no label pass in {pass_dir}/")
+        return found
     kinds = {r.get("labels", "perfect") for r in results}
     if len(kinds) <= 1:
         return results

@@ -451,6 +451,7 @@ TEST(Cli, EvalLocalizationLabelsAreCheckedBeforeTheWork) {
       {"network,rate=-1", "--labels: rate=-1 needs a positive number"},
       {"network,speed=2", "--labels: unknown key 'speed=2'"},
       {"perfect+netwrk", "--labels expects perfect or network"},
+      {"network,ground=sideways", "--labels: unknown key 'ground=sideways'"},
       {"perfect+network,every+perfect", "--labels: 'perfect' is given twice"},
       {"+", "--labels: no label pass given"},
   };

@@ -199,10 +199,11 @@ TEST(LocalizationExperiment, PassesOnTheSameFramesGiveWhatEachGivesAlone) {
   LabelPass network;
   network.labels = "network";
   network.network = loadSemanticsConfig(kSource + "/config/semantics-sim-network.yaml");
+  network.geometric_ground_removal = true;  // as the shipped network's file says
   network.dir = "network";
   LocalizationExperimentConfig c;
   c.preset = "tiny";
-  c.max_frames = 30;
+  c.max_frames = 25;
   c.query_runs = {"S2"};
   c.configs = {bothConfigs()[0]};
   c.class_maps_dir = kSource + "/config/class_maps";
@@ -231,6 +232,13 @@ TEST(LocalizationExperiment, PassesOnTheSameFramesGiveWhatEachGivesAlone) {
             readFileBytes(tmp.path() / "both/network/maps/semsegmap.map"));
   EXPECT_EQ(both.results[1].labelling.network_runs, alone.results[0].labelling.network_runs);
   EXPECT_GT(both.results[0].map_segments, 0u);
+  EXPECT_TRUE(toJson(both)["label_passes"][1]["geometric_ground_removal"].get<bool>());
+  // The pass's ground removal is its own: by class alone, the network's map differs.
+  network.geometric_ground_removal = false;
+  c.label_passes = {network};
+  evaluateLocalization(c, tmp.path() / "classes");
+  EXPECT_NE(readFileBytes(tmp.path() / "classes/maps/semsegmap.map"),
+            readFileBytes(tmp.path() / "network/maps/semsegmap.map"));
 }
 
 }  // namespace

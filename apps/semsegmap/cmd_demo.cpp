@@ -52,7 +52,9 @@ std::string writeDemoView(const LocalizationExperiment& e, const std::filesystem
 void addNetworkPass(LocalizationExperimentConfig& config) {
   LabelPass pass;
   pass.labels = "network";
-  pass.network = loadSemanticsConfig(shippedFile("config/semantics-sim-network.yaml"));
+  const std::filesystem::path file = shippedFile("config/semantics-sim-network.yaml");
+  pass.network = loadSemanticsConfig(file);
+  pass.geometric_ground_removal = loadSettings(file).local_map.geometric_ground_removal;
   pass.dir = "network";
   config.label_passes.push_back(std::move(pass));
   config.class_maps_dir = shippedFile("config/class_maps");
@@ -80,6 +82,9 @@ int runDemo(const CliArgs& a) {
             << "with the simulator's perfect camera labels and with the shipped segmentation "
                "network's (within "
             << network.budget_cores << " of a core"
+            << (config.label_passes.back().geometric_ground_removal
+                    ? ", the ground removed by geometry too"
+                    : "")
             << (network.rate_hz > 0
                     ? ", at most " + std::to_string(network.rate_hz) + " pictures a second a camera"
                     : "")

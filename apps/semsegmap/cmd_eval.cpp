@@ -85,10 +85,11 @@ DescriptorExperimentConfig descriptorConfig(const CliArgs& a) {
   return c;
 }
 
-// One pass of --labels: perfect | network[,rate=R][,budget=C][,every][,config=FILE]: the
-// simulator's labels, or the shipped segmentation network's (config/semantics-sim-network.yaml,
+// One pass of --labels: perfect | network[,rate=R][,budget=C][,every][,ground=G][,config=FILE]:
+// the simulator's labels, or the shipped segmentation network's (config/semantics-sim-network.yaml,
 // or FILE's semantics: section) at its shipped budget, at R pictures a second per camera, within
-// C cores, or on every picture.
+// C cores, or on every picture; the ground removed as the file's local_map section says, or by
+// class alone (ground=classes) or by geometry as well (ground=geometry).
 LabelPass labelPass(const std::string& spec) {
   LabelPass pass;
   pass.labels = spec;
@@ -104,6 +105,7 @@ LabelPass labelPass(const std::string& spec) {
     if (keys[i].rfind("config=", 0) == 0) file = keys[i].substr(7);
   SemanticsConfig& n = pass.network;
   n = loadSemanticsConfig(file);
+  pass.geometric_ground_removal = loadSettings(file).local_map.geometric_ground_removal;
   for (size_t i = 1; i < keys.size(); ++i) {
     const std::string& k = keys[i];
     const auto number = [&](size_t at) {
@@ -120,8 +122,11 @@ LabelPass labelPass(const std::string& spec) {
       n.budget_cores = number(7);
     } else if (k == "every") {
       n.rate_hz = n.budget_cores = n.latency_s = 0;
+    } else if (k == "ground=classes" || k == "ground=geometry") {
+      pass.geometric_ground_removal = k == "ground=geometry";
     } else if (k.rfind("config=", 0) != 0) {
-      throw UsageError("--labels: unknown key '" + k + "' (rate=R, budget=C, every, config=FILE)");
+      throw UsageError("--labels: unknown key '" + k +
+                       "' (rate=R, budget=C, every, ground=classes|geometry, config=FILE)");
     }
   }
   checkReplayable(n, file.string());
@@ -295,9 +300,9 @@ const OptionSpec kLabelNoise{"label-noise", Value::kCount, "L", "0",
 const OptionSpec kLabels{
     "labels", Value::kText, "SPEC", "perfect",
     "camera labels: perfect (the simulator's), or network[,rate=R][,budget=C][,every]"
-    "[,config=FILE]: the shipped segmentation network's on its budget, at R pictures a second "
-    "per camera, within C cores, or on every picture; several joined by + run on the same "
-    "frames"};
+    "[,ground=classes|geometry][,config=FILE]: the shipped segmentation network's on its "
+    "budget, at R pictures a second per camera, within C cores, or on every picture, the ground "
+    "removed by class alone or by geometry too; several joined by + run on the same frames"};
 const OptionSpec kRig{"rig", Value::kText, "KEYS", "",
                       "simulator keys for every run's rig, e.g. lidar=hdl64,cameras=front"};
 const OptionSpec kQueryOdometry{

@@ -102,6 +102,26 @@ def test_label_rate_table_takes_each_kind_of_labels_from_a_file_of_several(tmp_p
     assert write_table(tmp_path, "label-noise", [f"0={demo}"])[2] == "| 0 | 30 | 20 | 0 |"
 
 
+def test_label_rate_table_takes_a_label_pass_by_its_folder(tmp_path):
+    # eval localization --labels perfect+network,rate=2: the second pass's runs in its folder.
+    def passed(config, n, labels, folder):
+        return dict(localization_result("S2", config, n), labels=labels,
+                    dir=f"{folder}{config}_S2")
+    both = localization_json(tmp_path, "both", [
+        passed("semsegmap", 30, "perfect", ""), passed("segmap", 20, "perfect", ""),
+        passed("semsegmap", 12, "network,rate=2", "network_rate-2/"),
+        passed("segmap", 6, "network,rate=2", "network_rate-2/")])
+    rows = write_table(tmp_path, "label-rate", [
+        f"perfect={both}", f"network at 2 Hz={both}#network_rate-2"])
+    assert rows[2:] == ["| perfect | 30 | 20 | 1.50 | 0 | - |",
+                        "| network at 2 Hz | 12 | 6 | 2.00 | 0 | - |"]
+    doc = tmp_path / "doc.md"
+    failed = subprocess.run([sys.executable, source_file("scripts/write_results.py"), "s",
+                             f"x={both}#network_rate-9", "--table", "label-rate", "--doc",
+                             str(doc)], capture_output=True, text=True)
+    assert failed.returncode != 0 and "no label pass in network_rate-9/" in failed.stderr
+
+
 def test_segmentation_table_has_the_change_against_the_paper(tmp_path):
     seg = tmp_path / "segmentation.json"
     seg.write_text(json.dumps({

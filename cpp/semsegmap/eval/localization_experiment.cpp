@@ -39,6 +39,15 @@ PassLabelers passLabelers(const LocalizationExperimentConfig& cfg, const Dataset
   return labelers;
 }
 
+// The configurations as a pass runs them.
+std::vector<NamedConfig> passConfigs(const LocalizationExperimentConfig& cfg,
+                                     const LabelPass& pass) {
+  std::vector<NamedConfig> configs = cfg.configs;
+  if (pass.geometric_ground_removal)
+    for (NamedConfig& c : configs) c.config.local_map.geometric_ground_removal = true;
+  return configs;
+}
+
 // Hands each pass its frame: the rendered one, or a copy that the pass's network labels.
 void feedPasses(const Frame& frame, const PassLabelers& labelers,
                 const std::function<void(size_t pass, const Frame&)>& use) {
@@ -64,9 +73,9 @@ std::vector<std::vector<BuiltMap>> buildMaps(
                                              cfg.max_frames, cfg.label_noise, cfg.rig));
   const PassLabelers labelers = passLabelers(cfg, source->info());
   std::vector<std::vector<std::unique_ptr<MappingSession>>> sessions;
-  for (size_t p = 0; p < labelers.size(); ++p)
-    sessions.push_back(
-        mappingSessions(cfg.configs, source->info(), describers, cfg.picture_points_per_segment));
+  for (const LabelPass& pass : cfg.label_passes)
+    sessions.push_back(mappingSessions(passConfigs(cfg, pass), source->info(), describers,
+                                       cfg.picture_points_per_segment));
   e.interrupted =
       !forEachFrame(*source, "map " + cfg.map_run, progress, cfg.stop, [&](const Frame& frame) {
         feedPasses(frame, labelers, [&](size_t p, const Frame& f) {
@@ -75,7 +84,8 @@ std::vector<std::vector<BuiltMap>> buildMaps(
       });
   std::vector<std::vector<BuiltMap>> maps;
   for (size_t p = 0; p < sessions.size(); ++p)
-    maps.push_back(finishMaps(sessions[p], cfg.configs, out / cfg.label_passes[p].dir));
+    maps.push_back(finishMaps(sessions[p], passConfigs(cfg, cfg.label_passes[p]),
+                              out / cfg.label_passes[p].dir));
   return maps;
 }
 
@@ -142,10 +152,12 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
                             options);
   const PassLabelers labelers = passLabelers(cfg, source->info());
   std::vector<std::vector<std::unique_ptr<LocalizationSession>>> sessions(labelers.size());
-  for (size_t p = 0; p < labelers.size(); ++p)
-    for (size_t c = 0; c < cfg.configs.size(); ++c)
-      sessions[p].push_back(std::make_unique<LocalizationSession>(
-          cfg.configs[c].config, source->info(), maps[p][c].map, describers[c]));
+  for (size_t p = 0; p < labelers.size(); ++p) {
+    const std::vector<NamedConfig> configs = passConfigs(cfg, cfg.label_passes[p]);
+    for (size_t c = 0; c < configs.size(); ++c)
+      sessions[p].push_back(std::make_unique<LocalizationSession>(configs[c].config, source->info(),
+                                                                  maps[p][c].map, describers[c]));
+  }
   e.interrupted =
       !forEachFrame(*source, "localize " + run_name, progress, cfg.stop, [&](const Frame& frame) {
         feedPasses(frame, labelers, [&](size_t p, const Frame& f) {
@@ -264,7 +276,9 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
   j["label_noise"] = e.config.label_noise;
   j["label_passes"] = nlohmann::ordered_json::array();
   for (const LabelPass& pass : e.config.label_passes) {
-    nlohmann::ordered_json p = {{"labels", pass.labels}, {"dir", pass.dir.string()}};
+    nlohmann::ordered_json p = {{"labels", pass.labels},
+                                {"dir", pass.dir.string()},
+                                {"geometric_ground_removal", pass.geometric_ground_removal}};
     if (!pass.network.model.empty())
       p["network"] = {{"model", pass.network.model},
                       {"rate_hz", pass.network.rate_hz},

@@ -22,6 +22,9 @@ struct LabelPass {
   // within the budget of its settings (replayed on the data's clock); the same labels reach
   // every configuration. Empty model: the simulator's labels.
   SemanticsConfig network;
+  // Every configuration of the pass removes the ground by geometry as well as by class
+  // (local_map.geometric_ground_removal): what a network's labels need (its file says so).
+  bool geometric_ground_removal = false;
   std::filesystem::path dir;  // the pass's maps and runs, under the output folder ("": in it)
 };
 
