@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "cli_args.h"
+#include "eval_args.h"
 #include "interrupt.h"
 #include "progress.h"
 #include "resources.h"
@@ -50,11 +51,7 @@ std::string writeDemoView(const LocalizationExperiment& e, const std::filesystem
 // budget as well as the simulator's perfect ones (the paper's whole pipeline), on the same
 // rendered frames: their rows join the table, their files go to out/network/.
 void addNetworkPass(LocalizationExperimentConfig& config) {
-  LabelPass pass;
-  pass.labels = "network";
-  const std::filesystem::path file = shippedFile("config/semantics-sim-network.yaml");
-  pass.network = loadSemanticsConfig(file);
-  pass.geometric_ground_removal = loadSettings(file).local_map.geometric_ground_removal;
+  LabelPass pass = labelPass("network");
   pass.dir = "network";
   config.label_passes.push_back(std::move(pass));
   config.class_maps_dir = shippedFile("config/class_maps");

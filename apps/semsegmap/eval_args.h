@@ -6,11 +6,17 @@
 
 #include "cli_args.h"
 #include "semsegmap/eval/experiment.h"
+#include "semsegmap/eval/localization_experiment.h"
 
 namespace semsegmap::app {
 
 // The non-empty items of a list separated by `separator`.
 std::vector<std::string> splitList(const std::string& s, char separator = ',');
+
+// One label pass of `eval localization --labels` (the demo's network pass too):
+// perfect | network[,rate=R][,budget=C][,every][,ground=classes|geometry][,config=FILE]. Throws
+// UsageError for a spec it cannot read.
+LabelPass labelPass(const std::string& spec);
 
 // --configs: SemSegMap first, the SegMap baseline second. The default list names shipped
 // configs; a list the user types names their own files.

@@ -250,6 +250,8 @@ LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& 
                                             const ExperimentProgress& progress) {
   if (cfg.configs.empty())
     throw std::invalid_argument("the localization experiment needs at least one configuration");
+  if (cfg.label_passes.empty())
+    throw std::invalid_argument("the localization experiment needs at least one label pass");
   LocalizationExperiment e;
   e.config = cfg;
   for (int i = 0; i <= 100; ++i) e.thresholds.push_back(cfg.wrong_m * i / 100.0);
@@ -258,8 +260,6 @@ LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& 
   // Models load first: a missing one fails before minutes of simulation.
   std::vector<std::shared_ptr<Describer>> describers;
   for (const NamedConfig& c : cfg.configs) describers.push_back(makeDescriber(c.config.descriptor));
-  if (cfg.label_passes.empty())
-    throw std::invalid_argument("the localization experiment needs at least one label pass");
   const std::vector<std::vector<BuiltMap>> maps = buildMaps(e, describers, out, progress);
   for (const std::string& run_name : cfg.query_runs) {
     if (e.interrupted) break;  // no run starts after the stop request
