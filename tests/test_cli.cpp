@@ -94,7 +94,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"map", "float32"}},
     {"map",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "out",
-      "poses", "max-frames", "points", "float32"},
+      "into", "poses", "max-frames", "points", "float32"},
      {"world-seed", "map"}},
     {"localize",
      {"dataset", "rig", "odometry", "ground-truth", "kitti-calib", "labels", "config", "map", "out",
@@ -625,6 +625,46 @@ TEST(Cli, RuntimeErrorsExitOne) {
   EXPECT_EQ(r.err.rfind("semsegmap localize: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("missing.map"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("usage error"), std::string::npos);
+}
+
+// `map --into`: a drive on its own odometry joins a map as a new session; one that never
+// localizes against it is written beside --out, in its own frame, and says so (exit 3); --out is
+// never written with it. Joining by SLAM poses is a usage error.
+TEST(CliMapInto, ARunJoinsAMapAsASessionOrIsWrittenBeside) {
+  if (!SEMSEGMAP_WITH_SIM || !SEMSEGMAP_WITH_TORCH)
+    GTEST_SKIP() << "needs the simulator and libtorch (the shipped configuration's model)";
+  TempDir tmp;
+  const std::string a = (tmp.path() / "a.map").string(), ab = (tmp.path() / "ab.map").string();
+  const std::string config = " --config config/semsegmap.yaml";
+  const Result m =
+      run("map --dataset sim:world=1,run=S0,preset=tiny,frames=60" + config + " --out " + a);
+  ASSERT_EQ(m.code, 0) << m.err;
+  const Result into = run("map --dataset sim:world=1,run=S0,preset=tiny,frames=60,traffic=7" +
+                          config + " --poses odom --into " + a + " --out " + ab);
+  ASSERT_EQ(into.code, 0) << into.err;
+  EXPECT_NE(into.out.find("map 2 sessions"), std::string::npos) << into.out;
+  EXPECT_NE(into.out.find("localized "), std::string::npos) << into.out;
+  EXPECT_TRUE(std::filesystem::exists(ab));
+
+  const std::string abc = (tmp.path() / "abc.map").string();
+  const Result elsewhere = run("map --dataset sim:world=2,run=S0,preset=tiny,frames=30" + config +
+                               " --poses odom --into " + ab + " --out " + abc);
+  EXPECT_EQ(elsewhere.code, 3) << elsewhere.err;
+  EXPECT_FALSE(std::filesystem::exists(abc));
+  const std::string beside = (tmp.path() / "abc.unaligned.map").string();
+  EXPECT_TRUE(std::filesystem::exists(beside));
+  EXPECT_NE(elsewhere.err.find("not merged; its own map, in its own frame, written to " + beside),
+            std::string::npos)
+      << elsewhere.err;
+
+  const Result slam = run("map --dataset sim:world=1,run=S0,preset=tiny,frames=3" + config +
+                          " --poses slam --into " + a + " --out " + abc);
+  EXPECT_EQ(slam.code, 2) << slam.err;
+  EXPECT_NE(slam.err.find("--into joins a run by localizing it"), std::string::npos) << slam.err;
+  const Result missing = run("map --dataset sim:world=1,run=S0,preset=tiny,frames=3" + config +
+                             " --into " + (tmp.path() / "none.map").string() + " --out " + abc);
+  EXPECT_EQ(missing.code, 1) << missing.err;
+  EXPECT_NE(missing.err.find("none.map"), std::string::npos) << missing.err;
 }
 
 // A teacher is checked before the extraction (here the dataset does not even exist): the options

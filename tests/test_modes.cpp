@@ -15,6 +15,7 @@
 
 #include "build_options.h"
 #include "error_text.h"
+#include "oracle_describer.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/diagnostics.h"
@@ -31,29 +32,6 @@
 
 namespace semsegmap {
 namespace {
-
-// The same random vector for every observation of one ground-truth instance.
-class OracleDescriber : public Describer {
- public:
-  DescriptorKind kind() const override { return DescriptorKind::kEigen; }
-  int dimension() const override { return 8; }
-  std::string fingerprint() const override { return "oracle"; }
-  Eigen::MatrixXf describe(const std::vector<DescriptorInput>& batch) override {
-    Eigen::MatrixXf out(static_cast<Eigen::Index>(batch.size()), 8);
-    for (size_t i = 0; i < batch.size(); ++i) {
-      std::map<uint16_t, size_t> votes;
-      for (const EnrichedPoint& p : *batch[i].points) ++votes[p.instance_id];
-      uint16_t best = 0;
-      size_t most = 0;
-      for (const auto& [id, n] : votes)
-        if (n > most) best = id, most = n;
-      std::mt19937 rng(best);
-      std::normal_distribution<float> g;
-      for (int k = 0; k < 8; ++k) out(static_cast<Eigen::Index>(i), k) = g(rng);
-    }
-    return out;
-  }
-};
 
 PipelineConfig semsegmapConfig() {
   return loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap.yaml");

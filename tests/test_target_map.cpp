@@ -130,6 +130,60 @@ TEST(MapFile, ScanContextsRoundTripAndACorruptOneIsRefused) {
   EXPECT_EQ(randomMap(20, 16, false).scan_contexts.size(), 0u);
 }
 
+// A map merged from sessions (pipeline/session_merge.h) keeps each entry's segment id, session
+// and keyframe and each session's name, time and trajectory; a segment naming a session the map
+// does not hold is refused naming the file. A map of one run reads as each entry its own segment.
+TEST(MapFile, SessionsRoundTripAndASegmentOfNoSessionIsRefused) {
+  TargetMap map = randomMap(12, 16, false);
+  const auto path = tempPath("sessions.map");
+  saveTargetMap(path, map);
+  const TargetMap single = loadTargetMap(path);
+  EXPECT_TRUE(single.sessions.empty());
+  for (size_t i = 0; i < single.size(); ++i) EXPECT_EQ(single.segments[i].segment, i);
+
+  map.sessions.push_back({"first", 0, {}});
+  MapSession second{"sim:world=1,run=S1", 1796000000, {}};
+  for (int k = 0; k < 4; ++k)
+    second.trajectory.push_back(Eigen::Translation3d(10.0 * k, 1.0, 0.0) *
+                                Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d::UnitZ()));
+  map.sessions.push_back(second);
+  for (size_t i = 0; i < map.size(); ++i) {
+    map.segments[i].segment = static_cast<uint32_t>(i % 8);  // 8 segments, 4 seen twice
+    map.segments[i].session = i < 8 ? 0 : 1;
+    map.segments[i].keyframe = i < 8 ? 0 : static_cast<uint32_t>(i - 8);
+  }
+  saveTargetMap(path, map);
+  const TargetMap back = loadTargetMap(path);
+  ASSERT_EQ(back.sessions.size(), 2u);
+  EXPECT_EQ(back.sessions[1].name, second.name);
+  EXPECT_EQ(back.sessions[1].merged_unix_s, second.merged_unix_s);
+  ASSERT_EQ(back.sessions[1].trajectory.size(), 4u);
+  EXPECT_LT(translationError(back.sessions[1].trajectory[3], second.trajectory[3]), 1e-9);
+  EXPECT_LT(rotationErrorDeg(back.sessions[1].trajectory[3], second.trajectory[3]), 1e-3);
+  for (size_t i = 0; i < map.size(); ++i) {
+    EXPECT_EQ(back.segments[i].segment, map.segments[i].segment);
+    EXPECT_EQ(back.segments[i].session, map.segments[i].session);
+    EXPECT_EQ(back.segments[i].keyframe, map.segments[i].keyframe);
+  }
+
+  // Saving refuses what loading would: a keyframe beyond its session's trajectory.
+  TargetMap bad = map;
+  bad.segments[11].keyframe = 4;
+  EXPECT_THROW(saveTargetMap(tempPath("bad_sessions.map"), bad), std::invalid_argument);
+  // The last segment's session (after its uint32 segment id, before the checksum), made 7.
+  std::string bytes = readFileBytes(path);
+  const size_t at = bytes.size() - 8 - 10 + 4;
+  uint16_t session = 0;
+  std::memcpy(&session, &bytes[at], sizeof(session));
+  ASSERT_EQ(session, 1u) << "the layout docs/map-format.md gives";
+  session = 7;
+  std::memcpy(&bytes[at], &session, sizeof(session));
+  resign(bytes);
+  writeBytesAtomically(path, bytes);
+  const std::string error = expectLoadError(path);
+  EXPECT_NE(error.find(path.string() + ": segment 11: session 7 of 2"), std::string::npos) << error;
+}
+
 TEST(MapFile, SizeIsAtMost150BytesASegmentWith64dDescriptors) {
   const TargetMap map = randomMap(10000, 64, false);
   const auto path = tempPath("size.map");

@@ -1,6 +1,8 @@
 // semsegmap map: runs the pipeline over a mapping run and saves the target map.
+#include <ctime>
 #include <filesystem>
 #include <iostream>
+#include <set>
 
 #include "cli_args.h"
 #include "dataset_args.h"
@@ -9,12 +11,59 @@
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/pipeline/modes.h"
+#include "semsegmap/pipeline/session_merge.h"
 #include "semsegmap/pipeline/slam.h"
 #include "semsegmap/settings/config.h"
 
 namespace semsegmap::app {
 
 namespace {
+
+// Where a session that did not join the map goes instead of `out`: beside it, never over it.
+std::filesystem::path separatePath(const std::filesystem::path& out) {
+  std::filesystem::path p = out;
+  p.replace_extension(".unaligned" + out.extension().string());
+  return p;
+}
+
+// `map --into MAP`: the run joins MAP as a new session (pipeline/session_merge.h).
+int runMapInto(const CliArgs& a, const PipelineConfig& config, DatasetWithStages& data,
+               std::shared_ptr<Describer> describer, PoseSource poses, RunOptions options) {
+  const std::filesystem::path into = a.get("into"), out = a.get("out");
+  auto map = std::make_shared<const TargetMap>(loadTargetMap(into));
+  Progress progress("map", 0);
+  options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
+  const MergedSession m =
+      runSessionMerge(*data.source, config, map, std::move(describer), a.get("dataset"),
+                      static_cast<int64_t>(std::time(nullptr)), poses, options);
+  MapWriteOptions write;
+  write.float16 = !a.has("float32");
+  if (!m.aligned) {
+    const std::filesystem::path separate = separatePath(out);
+    saveTargetMap(separate, m.map, write);
+    std::cerr << "semsegmap map: " << a.get("dataset") << " localized " << m.ties.size()
+              << " times against " << into.string() << " ("
+              << config.session_merge.min_localizations
+              << " needed): not merged; its own map, in its own frame, written to "
+              << separate.string() << "\n";
+    return 3;
+  }
+  const uint64_t bytes = saveTargetMap(out, m.map, write);
+  std::set<uint32_t> segments;
+  for (const MapSegment& s : m.map.segments) segments.insert(s.segment);
+  std::printf(
+      "frames %zu  localized %zu against %s (mean residual %.2f m after the pose graph)  "
+      "session entries %zu, %zu of them observations of segments the map held\n"
+      "map %zu sessions, %zu entries of %zu segments, %llu bytes\n",
+      m.mapping.stats.frames, m.ties.size(), into.string().c_str(), m.mean_tie_residual_m,
+      m.entries, m.same_segments, m.map.sessions.size(), m.map.size(), segments.size(),
+      static_cast<unsigned long long>(bytes));
+  std::cout << "wrote " << out.string() << "\n";
+  if (m.mapping.stats.interrupted)
+    return interruptedRun("map", m.mapping.stats.frames, options.frameCount(*data.source),
+                          out.string());
+  return 0;
+}
 
 int runMap(const CliArgs& a) {
   PipelineConfig config = loadPipelineConfig(a.get("config"));
@@ -37,13 +86,20 @@ int runMap(const CliArgs& a) {
                             : source->info().has_ground_truth_poses ? "gt"
                                                                     : "odom";
 
-  Progress progress("map", 0);
   RunOptions options;
   options.max_frames = a.frameLimit();
-  options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   // The map of the frames done is whole and usable: saved as any other.
   options.stop = stopToken();
   options.stages = data.stages;
+  if (a.has("into")) {
+    if (poses == "slam")
+      throw UsageError(
+          "--into joins a run by localizing it against the map: use --poses odom "
+          "or gt, not slam");
+    return runMapInto(a, config, data, describer, parsePoseSource(poses), options);
+  }
+  Progress progress("map", 0);
+  options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   TargetMap map;
   RunStats stats;
   size_t segments = 0, earlier = 0, duplicates = 0;
@@ -93,6 +149,9 @@ const CommandSpec& mapCommand() {
               {"config", Value::kText, "FILE", "", "pipeline configuration, config/*.yaml",
                kRequired},
               {"out", Value::kText, "MAP", "", "the map file to write", kRequired},
+              {"into", Value::kText, "MAP", "",
+               "join the run to this map as a new session (docs/map-store.md); --out gets "
+               "the merged map"},
               {"poses", Value::kText, "gt|odom|slam", "",
                "poses the map is built with (default: gt when the data has them, else odom)"},
               maxFramesOption(),

@@ -297,6 +297,12 @@ class LoopClosureConfig:
     graph: PoseGraphConfig
     def __init__(self, **fields: object) -> None: ...
 
+class SessionMergeConfig:
+    _fields: tuple[str, ...]
+    same_segment_m: float
+    min_localizations: int
+    def __init__(self, **fields: object) -> None: ...
+
 class PipelineConfig:
     _fields: tuple[str, ...]
     enrichment: EnrichmentConfig
@@ -306,6 +312,7 @@ class PipelineConfig:
     localization: LocalizationConfig
     target_map: TargetMapBuilderConfig
     loop_closure: LoopClosureConfig
+    session_merge: SessionMergeConfig
     def __init__(self, **fields: object) -> None: ...
 
 def load_config(path: _Path) -> PipelineConfig: ...

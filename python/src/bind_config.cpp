@@ -136,6 +136,9 @@ void bindLocalizationConfigs(py::module_& m) {
       .field("exclude_recent_m", &LoopClosureConfig::exclude_recent_m)
       .field("min_travel_between_loops_m", &LoopClosureConfig::min_travel_between_loops_m)
       .field("graph", &LoopClosureConfig::graph);
+  StructBinding<SessionMergeConfig>(m, "SessionMergeConfig", "pipeline/pipeline_config.h")
+      .field("same_segment_m", &SessionMergeConfig::same_segment_m)
+      .field("min_localizations", &SessionMergeConfig::min_localizations);
 }
 
 const char* kindName(SettingKind kind) {
@@ -185,7 +188,8 @@ void bindConfig(py::module_& m) {
       .field("descriptor", &PipelineConfig::descriptor)
       .field("localization", &PipelineConfig::localization)
       .field("target_map", &PipelineConfig::target_map)
-      .field("loop_closure", &PipelineConfig::loop_closure);
+      .field("loop_closure", &PipelineConfig::loop_closure)
+      .field("session_merge", &PipelineConfig::session_merge);
   m.def(
       "load_config", [](const std::filesystem::path& path) { return loadPipelineConfig(path); },
       py::arg("path"),

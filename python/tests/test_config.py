@@ -65,7 +65,7 @@ def test_keywords_repr_fields_and_copies():
     assert c.segmentation.d_segment_m == pytest.approx(0.3)
     assert set(ssm.PipelineConfig._fields) == {
         "enrichment", "local_map", "segmentation", "descriptor", "localization", "target_map",
-        "loop_closure"}
+        "loop_closure", "session_merge"}
 
 
 @pytest.mark.parametrize("text, message", [

@@ -1,5 +1,6 @@
 #include "semsegmap/artefacts/map_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -19,6 +20,7 @@ constexpr std::string_view kMapMagic("SSMMAP\r\n", 8);
 constexpr uint32_t kFlagFloat16 = 1u << 0;
 constexpr uint32_t kFlagPoints = 1u << 1;
 constexpr uint32_t kFlagScanContexts = 1u << 2;
+constexpr uint32_t kFlagSessions = 1u << 3;
 // A scan context grid finer than this is a corrupt header, refused before allocating it.
 constexpr uint16_t kMaxScanContextBins = 1024;
 // A map records a few dozen settings; more is a corrupt count, refused before reading on.
@@ -77,6 +79,27 @@ std::string firstNonFinite(const TargetMap& map) {
   return {};
 }
 
+// A pose as float64 x, y, z and a float32 unit quaternion w, x, y, z (40 bytes).
+void putPose(BinaryWriter& w, const Pose& T) {
+  const Eigen::Vector3d t = T.translation();
+  const Eigen::Quaterniond q(T.linear());
+  for (int k = 0; k < 3; ++k) w.put<double>(t[k]);
+  for (double v : {q.w(), q.x(), q.y(), q.z()}) w.put<float>(static_cast<float>(v));
+}
+
+// `what` names the pose in the error ("scan context 3").
+Pose getPose(BinaryReader& r, const std::string& what) {
+  Pose T = Pose::Identity();
+  for (int k = 0; k < 3; ++k) T.translation()[k] = r.get<double>(what.c_str());
+  double q[4];
+  for (double& v : q) v = r.get<float>(what.c_str());
+  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+  if (!T.translation().allFinite() || !(std::abs(rotation.norm() - 1.0) < 1e-3))
+    r.fail(what + ": not a pose");
+  T.linear() = rotation.normalized().toRotationMatrix();
+  return T;
+}
+
 // The scan contexts (flag bit 2): the grid, then per scan its frame and its bins as float16.
 void putScanContexts(BinaryWriter& w, const ScanContextDatabase& db) {
   const ScanContextConfig& c = db.config();
@@ -86,10 +109,7 @@ void putScanContexts(BinaryWriter& w, const ScanContextDatabase& db) {
   w.put<float>(static_cast<float>(c.height_offset_m));
   w.put<uint64_t>(db.size());
   for (const ScanContextDatabase::MappedScan& s : db.scans()) {
-    const Eigen::Vector3d t = s.T_world_scan.translation();
-    const Eigen::Quaterniond q(s.T_world_scan.linear());
-    for (int k = 0; k < 3; ++k) w.put<double>(t[k]);
-    for (double v : {q.w(), q.x(), q.y(), q.z()}) w.put<float>(static_cast<float>(v));
+    putPose(w, s.T_world_scan);
     for (Eigen::Index i = 0; i < s.context.bins.size(); ++i) putHalf(w, s.context.bins(i));
   }
 }
@@ -109,14 +129,7 @@ ScanContextDatabase getScanContexts(BinaryReader& r) {
   const uint64_t n = r.getCount(24 + 16 + 2 * bins, "the scan contexts");
   ScanContextDatabase db(c);
   for (uint64_t i = 0; i < n; ++i) {
-    Pose T = Pose::Identity();
-    for (int k = 0; k < 3; ++k) T.translation()[k] = r.get<double>("a scan context");
-    double q[4];
-    for (double& v : q) v = r.get<float>("a scan context");
-    const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
-    if (!T.translation().allFinite() || !(std::abs(rotation.norm() - 1.0) < 1e-3))
-      r.fail("scan context " + std::to_string(i) + ": not a pose");
-    T.linear() = rotation.normalized().toRotationMatrix();
+    const Pose T = getPose(r, "scan context " + std::to_string(i));
     Eigen::MatrixXf b(c.rings, c.sectors);
     for (Eigen::Index k = 0; k < b.size(); ++k) b(k) = getHalf(r, "a scan context");
     if (!b.allFinite() || (b.array() < 0).any())
@@ -124,6 +137,59 @@ ScanContextDatabase getScanContexts(BinaryReader& r) {
     db.add(scanContextOfBins(std::move(b)), T);
   }
   return db;
+}
+
+// The sessions (flag bit 3): each one's name, time and trajectory, then per segment its segment
+// id, session and keyframe.
+void putSessions(BinaryWriter& w, const std::filesystem::path& path, const TargetMap& map) {
+  // Refused here because the loader refuses it: a saved map always reads back.
+  for (size_t i = 0; i < map.segments.size(); ++i) {
+    const MapSegment& s = map.segments[i];
+    if (s.session >= map.sessions.size() ||
+        s.keyframe >= std::max<size_t>(map.sessions[s.session].trajectory.size(), 1))
+      throw std::invalid_argument(path.string() + ": segment " + std::to_string(i) + ": session " +
+                                  std::to_string(s.session) + " or keyframe " +
+                                  std::to_string(s.keyframe) + " out of range");
+  }
+  w.put<uint16_t>(static_cast<uint16_t>(map.sessions.size()));
+  for (const MapSession& s : map.sessions) {
+    w.putString32(s.name);
+    w.put<int64_t>(s.merged_unix_s);
+    w.put<uint64_t>(s.trajectory.size());
+    for (const Pose& T : s.trajectory) putPose(w, T);
+  }
+  for (const MapSegment& s : map.segments) {
+    w.put<uint32_t>(s.segment);
+    w.put<uint16_t>(s.session);
+    w.put<uint32_t>(s.keyframe);
+  }
+}
+
+void getSessions(BinaryReader& r, TargetMap& map) {
+  const uint16_t n = r.get<uint16_t>("the sessions");
+  if (n == 0) r.fail("a sessions block without sessions");
+  map.sessions.resize(n);
+  for (MapSession& s : map.sessions) {
+    s.name = r.getString32("the sessions");
+    s.merged_unix_s = r.get<int64_t>("the sessions");
+    const uint64_t poses = r.getCount(40, "the sessions");
+    for (uint64_t i = 0; i < poses; ++i)
+      s.trajectory.push_back(getPose(r, "session " + s.name + " pose " + std::to_string(i)));
+  }
+  r.need(map.segments.size(), 10, "the segments' sessions");
+  for (size_t i = 0; i < map.segments.size(); ++i) {
+    MapSegment& s = map.segments[i];
+    s.segment = r.get<uint32_t>("the segments' sessions");
+    s.session = r.get<uint16_t>("the segments' sessions");
+    s.keyframe = r.get<uint32_t>("the segments' sessions");
+    if (s.session >= n)
+      r.fail("segment " + std::to_string(i) + ": session " + std::to_string(s.session) + " of " +
+             std::to_string(n));
+    const size_t frames = map.sessions[s.session].trajectory.size();
+    if (s.keyframe >= std::max<size_t>(frames, 1))
+      r.fail("segment " + std::to_string(i) + ": keyframe " + std::to_string(s.keyframe) +
+             " of a trajectory of " + std::to_string(frames));
+  }
 }
 
 }  // namespace
@@ -143,8 +209,11 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
   w.putBytes(kMapMagic.data(), kMapMagic.size());
   w.put<uint32_t>(kMapFormatVersion);
   const bool scan_contexts = map.scan_contexts.size() > 0;
+  const bool sessions = !map.sessions.empty();
+  if (map.sessions.size() > 65535)
+    throw std::invalid_argument(path.string() + ": more than 65535 sessions");
   w.put<uint32_t>((options.float16 ? kFlagFloat16 : 0u) | (points ? kFlagPoints : 0u) |
-                  (scan_contexts ? kFlagScanContexts : 0u));
+                  (scan_contexts ? kFlagScanContexts : 0u) | (sessions ? kFlagSessions : 0u));
   w.putString8(map.descriptor);
   w.putString8(map.fingerprint);
   w.put<uint32_t>(static_cast<uint32_t>(map.dimension()));
@@ -172,6 +241,7 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
         for (int k = 0; k < 3; ++k) putHalf(w, p[k] - s.centroid[k]);
     }
   if (scan_contexts) putScanContexts(w, map.scan_contexts);
+  if (sessions) putSessions(w, path, map);
   w.putChecksum();
   writeBytesAtomically(path, w.bytes());
   return w.bytes().size();
@@ -190,7 +260,7 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
            std::to_string(kMapFormatVersion) + " (rebuild the map with `semsegmap map`)");
   r.checksummed();
   const uint32_t flags = r.get<uint32_t>("the header");
-  if (flags & ~(kFlagFloat16 | kFlagPoints | kFlagScanContexts))
+  if (flags & ~(kFlagFloat16 | kFlagPoints | kFlagScanContexts | kFlagSessions))
     r.fail("unknown header flags " + std::to_string(flags));
   TargetMap map;
   map.descriptor = r.getString8("the header");
@@ -220,6 +290,11 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
         for (int k = 0; k < 3; ++k) p[k] = s.centroid[k] + getHalf(r, "the points");
     }
   if (flags & kFlagScanContexts) map.scan_contexts = getScanContexts(r);
+  if (flags & kFlagSessions)
+    getSessions(r, map);
+  else  // the map of one run: each entry its own segment
+    for (size_t i = 0; i < map.segments.size(); ++i)
+      map.segments[i].segment = static_cast<uint32_t>(i);
   r.expectEnd("the segments");
   if (const std::string bad = firstNonFinite(map); !bad.empty()) r.fail(bad);
   map.source = path.string();

@@ -52,6 +52,7 @@ TargetMap TargetMapBuilder::build() const {
     map.descriptors.row(static_cast<Eigen::Index>(map.segments.size())) =
         descriptors_[i].transpose();
     map.segments.push_back(segments_[i]);
+    map.segments.back().segment = static_cast<uint32_t>(map.segments.size() - 1);
   }
   return map;
 }

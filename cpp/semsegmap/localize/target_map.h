@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "semsegmap/core/class_table.h"
+#include "semsegmap/core/pose.h"
 #include "semsegmap/localize/scan_context.h"
 
 namespace semsegmap {
@@ -20,6 +21,20 @@ struct MapSegment {
   uint32_t n_points = 0;
   ClassId majority_class = cls::kUnknown;
   std::vector<Eigen::Vector3f> points;  // optional: a subsample, map frame
+  // A map merged from several sessions (pipeline/session_merge.h) keeps each session's
+  // observation of a place both saw, under one segment id; a map of one run gives every entry
+  // its own (its index).
+  uint32_t segment = 0;
+  uint16_t session = 0;   // index into TargetMap::sessions
+  uint32_t keyframe = 0;  // the session's frame whose pose placed it (MapSession::trajectory)
+};
+
+// One drive that built part of a map: the first defines the map's frame, each later one was
+// aligned to it by localizing against it (pipeline/session_merge.h).
+struct MapSession {
+  std::string name;              // the data it came from
+  int64_t merged_unix_s = 0;     // when it joined the map
+  std::vector<Pose> trajectory;  // its frames' poses in the map frame (empty for the first)
 };
 
 // The settings a map's segments depend on (voxel size, growing radius, penalties...), as
@@ -38,6 +53,9 @@ struct TargetMap {
   // Scan contexts of the mapping run's scans (target_map.scan_context_apart_m), in the map frame:
   // a relocalization checks the places they propose beside those its segments vote for.
   ScanContextDatabase scan_contexts;
+  // The sessions the map was merged from; empty for the map of one run (all its segments are
+  // session 0's).
+  std::vector<MapSession> sessions;
   std::string source;  // the file it was loaded from, for messages; empty for a map in memory
 
   size_t size() const { return segments.size(); }

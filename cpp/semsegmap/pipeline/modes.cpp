@@ -93,7 +93,8 @@ void MappingSession::add(const std::vector<Segment>& segments,
                          const std::vector<Eigen::VectorXf>& d) {
   const double apart = config_.target_map.earlier_observations_apart_m;
   for (size_t i = 0; i < segments.size(); ++i) {
-    const MapSegment final = mapSegmentOf(segments[i], config_.target_map.max_points_per_segment);
+    MapSegment final = mapSegmentOf(segments[i], config_.target_map.max_points_per_segment);
+    final.keyframe = currentKeyframe();
     // The earlier observations first: the builder lets a later segment replace an earlier one
     // nearby, and the final observation is the most complete.
     if (auto views = earlier_.extract(segments[i].id))
@@ -144,6 +145,7 @@ void MappingSession::keepEarlierObservations(const FrameResult& r) {
     k.segment.centroid = e.centroid;
     k.segment.n_points = e.n_points;
     k.segment.majority_class = e.majority_class;
+    k.segment.keyframe = currentKeyframe();
     k.segment.points =
         subsamplePoints(pipeline_.observedPoints(id), config_.target_map.max_points_per_segment);
     k.descriptor = e.descriptor;

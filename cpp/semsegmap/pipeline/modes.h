@@ -46,7 +46,8 @@ struct RunStats {
 
 struct MappingRun {
   TargetMap map;
-  std::vector<Pose> trajectory;     // the poses the map was built with
+  // The poses the map was built with, one per frame: MapSegment::keyframe indexes them.
+  std::vector<Pose> trajectory;
   size_t segments = 0;              // finished segments before removing duplicates
   size_t earlier_observations = 0;  // kept beside them (target_map.earlier_observations_apart_m)
   size_t duplicates_removed = 0;    // of either
@@ -69,6 +70,8 @@ class MappingSession {
   // (target_map.earlier_observations_apart_m): each is still in the local map.
   std::vector<SegmentId> segmentsWithEarlierObservations() const;
   const Pipeline& pipeline() const { return pipeline_; }
+  // The poses of the frames so far (MappingRun::trajectory).
+  const std::vector<Pose>& trajectory() const { return run_.trajectory; }
 
  private:
   void add(const std::vector<Segment>& segments, const std::vector<Eigen::VectorXf>& d);
@@ -85,6 +88,11 @@ class MappingSession {
     Eigen::Vector3f since = Eigen::Vector3f::Zero();  // centroid of the last kept, or the first
   };
   void keep(std::vector<KeptObservation>& kept, KeptObservation observation) const;
+  // The frame (index into the run's trajectory) whose pose places what is added now: a merged
+  // session's segments follow their frame's corrected pose (pipeline/session_merge.h).
+  uint32_t currentKeyframe() const {
+    return static_cast<uint32_t>(run_.trajectory.empty() ? 0 : run_.trajectory.size() - 1);
+  }
   PipelineConfig config_;
   Pipeline pipeline_;
   TargetMapBuilder builder_;

@@ -50,6 +50,17 @@ struct LoopClosureConfig {
   PoseGraphConfig graph{0.05, 0.005, 0.3, 0.02};
 };
 
+// A new session joining a map (pipeline/session_merge.h).
+struct SessionMergeConfig {
+  // The session's observation of a segment this near an older session's observation of the same
+  // class (the one of nearest descriptor, when several are) is an observation of that segment,
+  // not a new segment. Two sessions' final observations of one object differ by up to a metre
+  // (the tiny world, tests/test_session_merge.cpp).
+  double same_segment_m = 1.5;
+  // Localizations against the map a session needs to join it; with fewer it stays separate.
+  size_t min_localizations = 3;
+};
+
 struct PipelineConfig {
   EnrichmentConfig enrichment;
   LocalMapConfig local_map;
@@ -58,6 +69,7 @@ struct PipelineConfig {
   LocalizationConfig localization;
   TargetMapBuilderConfig target_map;
   LoopClosureConfig loop_closure;
+  SessionMergeConfig session_merge;
 };
 
 }  // namespace semsegmap

@@ -294,6 +294,10 @@ std::vector<Setting> mapAndLoopSettings() {
             "the pose graph solver's iterations"),
       count(SEMSEGMAP_AT(loop_closure.graph.threads), 1, 1024, kNotRecorded,
             "the pose graph solver's threads"),
+      number(SEMSEGMAP_AT(session_merge.same_segment_m), kNotRecorded,
+             "a merged session's segment this near an older one of its class is that segment"),
+      count(SEMSEGMAP_AT(session_merge.min_localizations), 1, 1000000, kNotRecorded,
+            "localizations a session needs to join a map"),
   };
 }
 
