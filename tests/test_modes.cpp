@@ -15,6 +15,7 @@
 
 #include "build_options.h"
 #include "error_text.h"
+#include "kitti_raw_sample.h"
 #include "oracle_describer.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -557,14 +558,10 @@ TEST(Modes, RefinementRefusesAMapWithoutPoints) {
 // the identity (odometry is the identity without oxts). The descriptors are the shipped model's,
 // trained on simulated data only; in a build without libtorch, the eigenvalue features.
 TEST(Modes, RealDataConfigMapsAndLocalizesTheKittiSample) {
-  PipelineConfig config =
-      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/lidar-camera.yaml");
-  if (!SEMSEGMAP_WITH_TORCH) config.descriptor = DescriptorConfig{"eigen", "", 64, ""};
+  const PipelineConfig config = test_support::realRigConfig();
   EXPECT_EQ(config.localization.localizer.verification.min_inliers, 7);
-  const std::string spec = std::string("kitti-raw:") + SEMSEGMAP_SHARED_DATA +
-                           "/kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
-  if (!std::filesystem::exists(spec.substr(10)))
-    GTEST_SKIP() << "the real KITTI sample is absent (" << spec.substr(10) << ")";
+  SEMSEGMAP_SKIP_WITHOUT_KITTI_RAW_SAMPLE();
+  const std::string spec = "kitti-raw:" + test_support::kittiRawSampleRun().string();
   // The shipped model: real data has no instance ids for an oracle.
   const std::shared_ptr<Describer> describer = makeDescriber(config.descriptor, 1);
   // The sample has no oxts: its poses come from LiDAR odometry (identity poses are refused).

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "build_options.h"
+#include "kitti_raw_sample.h"
 #include "oracle_describer.h"
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
@@ -156,13 +157,9 @@ TEST(SessionMerge, ASessionThatNeverLocalizesStaysSeparateInItsOwnFrame) {
 // configuration and its shipped model) mapped, then driven again in a frame 300 m away: it
 // joins where the first drive was, and sees the same segments.
 TEST(SessionMerge, TheRealKittiSampleJoinsItsOwnMapFromAnotherFrame) {
-  PipelineConfig real =
-      loadPipelineConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/lidar-camera.yaml");
-  if (!SEMSEGMAP_WITH_TORCH) real.descriptor = DescriptorConfig{"eigen", "", 64, ""};
-  const std::string spec = std::string("kitti-raw:") + SEMSEGMAP_SHARED_DATA +
-                           "/kitti_raw_2011_09_26_sample/2011_09_26/sample_sync";
-  if (!std::filesystem::exists(spec.substr(10)))
-    GTEST_SKIP() << "the real KITTI sample is absent (" << spec.substr(10) << ")";
+  SEMSEGMAP_SKIP_WITHOUT_KITTI_RAW_SAMPLE();
+  const PipelineConfig real = test_support::realRigConfig();
+  const std::string spec = "kitti-raw:" + test_support::kittiRawSampleRun().string();
   const std::shared_ptr<Describer> describer = makeDescriber(real.descriptor, 1);
   DatasetOptions lidar_odometry;
   lidar_odometry.odometry = "lidar";

@@ -139,18 +139,29 @@ ScanContextDatabase getScanContexts(BinaryReader& r) {
   return db;
 }
 
+// Every segment's session exists and its keyframe lies within that session's trajectory (a
+// session without one, the map's first, has keyframe 0 alone). Empty when all do.
+std::string firstOutOfSession(const TargetMap& map) {
+  for (size_t i = 0; i < map.segments.size(); ++i) {
+    const MapSegment& s = map.segments[i];
+    const std::string segment = "segment " + std::to_string(i) + ": ";
+    if (s.session >= map.sessions.size())
+      return segment + "session " + std::to_string(s.session) + " of " +
+             std::to_string(map.sessions.size());
+    const size_t frames = map.sessions[s.session].trajectory.size();
+    if (s.keyframe >= std::max<size_t>(frames, 1))
+      return segment + "keyframe " + std::to_string(s.keyframe) + " of a trajectory of " +
+             std::to_string(frames);
+  }
+  return {};
+}
+
 // The sessions (flag bit 3): each one's name, time and trajectory, then per segment its segment
 // id, session and keyframe.
 void putSessions(BinaryWriter& w, const std::filesystem::path& path, const TargetMap& map) {
   // Refused here because the loader refuses it: a saved map always reads back.
-  for (size_t i = 0; i < map.segments.size(); ++i) {
-    const MapSegment& s = map.segments[i];
-    if (s.session >= map.sessions.size() ||
-        s.keyframe >= std::max<size_t>(map.sessions[s.session].trajectory.size(), 1))
-      throw std::invalid_argument(path.string() + ": segment " + std::to_string(i) + ": session " +
-                                  std::to_string(s.session) + " or keyframe " +
-                                  std::to_string(s.keyframe) + " out of range");
-  }
+  if (const std::string bad = firstOutOfSession(map); !bad.empty())
+    throw std::invalid_argument(path.string() + ": " + bad);
   w.put<uint16_t>(static_cast<uint16_t>(map.sessions.size()));
   for (const MapSession& s : map.sessions) {
     w.putString32(s.name);
@@ -177,19 +188,12 @@ void getSessions(BinaryReader& r, TargetMap& map) {
       s.trajectory.push_back(getPose(r, "session " + s.name + " pose " + std::to_string(i)));
   }
   r.need(map.segments.size(), 10, "the segments' sessions");
-  for (size_t i = 0; i < map.segments.size(); ++i) {
-    MapSegment& s = map.segments[i];
+  for (MapSegment& s : map.segments) {
     s.segment = r.get<uint32_t>("the segments' sessions");
     s.session = r.get<uint16_t>("the segments' sessions");
     s.keyframe = r.get<uint32_t>("the segments' sessions");
-    if (s.session >= n)
-      r.fail("segment " + std::to_string(i) + ": session " + std::to_string(s.session) + " of " +
-             std::to_string(n));
-    const size_t frames = map.sessions[s.session].trajectory.size();
-    if (s.keyframe >= std::max<size_t>(frames, 1))
-      r.fail("segment " + std::to_string(i) + ": keyframe " + std::to_string(s.keyframe) +
-             " of a trajectory of " + std::to_string(frames));
   }
+  if (const std::string bad = firstOutOfSession(map); !bad.empty()) r.fail(bad);
 }
 
 }  // namespace

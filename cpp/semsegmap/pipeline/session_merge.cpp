@@ -101,13 +101,10 @@ TargetMap movedSession(const MappingRun& run, const std::vector<Pose>& T_map_bas
   return moved;
 }
 
-// The session alone, in its own frame: one session whose entries are each their own segment.
+// The session alone, in its own frame: one session whose entries are each their own segment (as
+// TargetMapBuilder numbers them).
 TargetMap separateSession(const MappingRun& run, MapSession info) {
   TargetMap map = run.map;
-  for (size_t i = 0; i < map.segments.size(); ++i) {
-    map.segments[i].segment = static_cast<uint32_t>(i);
-    map.segments[i].session = 0;
-  }
   info.trajectory = run.trajectory;
   map.sessions = {std::move(info)};
   return map;
@@ -143,7 +140,7 @@ MergedSession SessionMerge::finish(const std::string& name, int64_t now_unix_s) 
   out.ties = ties_;
   out.entries = out.mapping.map.size();
   MapSession info{name, now_unix_s, {}};
-  if (ties_.empty() || ties_.size() < config_.session_merge.min_localizations) {
+  if (ties_.size() < config_.session_merge.min_localizations) {  // at least 1 (setting table)
     out.map = separateSession(out.mapping, std::move(info));
     return out;
   }
