@@ -21,6 +21,9 @@ packages=(
   libvisualization-msgs-dev
   python3-rosmaster python3-roslaunch python3-rosbag python3-rostopic python3-std-srvs rosout
   gnuplot-nox
+  # the map store (store/pg_map_store.h): libpq to build; the server and PostGIS for its tests,
+  # which start a throwaway cluster of their own (tests/pg_cluster.h)
+  libpq-dev postgresql postgresql-15-postgis-3
   # the tests and the benchmark generate their small ONNX segmentation networks with it
   python3-onnx python3-numpy
   # the Python module (python/, SEMSEGMAP_WITH_PYTHON) and its pytest suite, for Debian's python3

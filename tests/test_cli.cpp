@@ -155,6 +155,11 @@ const std::vector<CommandOptions> kAllCommands = {
       "max-frames"},
      {"world-seed", "configs", "map-frames"}},
     {"eval labels", {"dataset", "config", "out", "every", "max-frames"}, {"rig", "labels"}},
+    {"maps list", {"store"}, {"map", "out"}},
+    {"maps show", {"map"}, {"store", "out"}},
+    {"maps export", {"map", "out"}, {"from"}},
+    {"maps import", {"from", "map"}, {"out"}},
+    {"maps drop", {"map", "session"}, {"out"}},
     {"eval paper",
      {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run", "config",
       "models", "descriptors", "threads", "descriptor-run", "map-run", "query-runs"},
@@ -165,6 +170,7 @@ const std::vector<CommandOptions> kAllCommands = {
 // train-segmentation need SEMSEGMAP_WITH_TORCH.
 bool built(const std::string& command) {
   if (command == "train" || command == "train-segmentation") return SEMSEGMAP_WITH_TORCH;
+  if (command.rfind("maps ", 0) == 0) return SEMSEGMAP_WITH_POSTGRES;
   if (command == "eval labels") return true;     // any dataset with label images
   if (command == "eval revisits") return true;   // any recording with ground truth
   if (command == "eval semantics") return true;  // any dataset with per-point ground truth

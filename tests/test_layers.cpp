@@ -27,7 +27,8 @@ std::map<std::string, std::set<std::string>> makeTable() {
   const std::set<std::string> stages = {"core",     "semantics", "enrich", "local_map", "segment",
                                         "describe", "localize",  "graph",  "odometry"};
   const std::set<std::string> below_files = with(stages, {"pipeline", "learn", "io"});
-  const std::set<std::string> files = with(below_files, {"settings", "artefacts", "outputs"});
+  const std::set<std::string> files =
+      with(below_files, {"settings", "artefacts", "outputs", "store"});
   const std::set<std::string> below_viz = with(files, {"sim", "datasets"});
   return {
       {"core", {}},
@@ -48,6 +49,8 @@ std::map<std::string, std::set<std::string>> makeTable() {
       {"settings", with(stages, {"pipeline", "io"})},            // config files
       {"artefacts", with(stages, {"pipeline", "learn", "io"})},  // maps, models, caches
       {"outputs", with(stages, {"pipeline", "io"})},             // what a run writes
+      // where maps live: files or a PostgreSQL store
+      {"store", with(stages, {"pipeline", "learn", "io", "artefacts"})},
       {"datasets", with(files, {"sim"})},
       {"viz", below_viz},
       {"eval", with(below_viz, {"viz"})},
@@ -109,7 +112,7 @@ TEST(Layers, EveryFolderIncludesOnlyFromTheFoldersBelowIt) {
 TEST(Layers, StagesNeverIncludeIoOrSim) {
   for (const std::string& stage : kStages) {
     const auto& may = allowed().at(stage);
-    for (const char* files : {"io", "settings", "artefacts", "outputs", "sim", "datasets"})
+    for (const char* files : {"io", "settings", "artefacts", "outputs", "store", "sim", "datasets"})
       EXPECT_FALSE(may.count(files)) << stage << " may include " << files;
   }
 }

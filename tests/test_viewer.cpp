@@ -1,7 +1,8 @@
 // What `semsegmap view` reads and the scene its page is given: matches.csv and trajectory.csv
 // written beside localizations.csv and read back, the folders of `slam` and `segment` read back
 // with one-line errors naming the file, and the scene's JSON (counts, positions relative to its
-// origin, points rebuilt from their 16-bit offsets, the estimated trajectory, escaping).
+// origin, points rebuilt from their 16-bit offsets, the estimated trajectory, the map's sessions,
+// escaping).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -240,6 +241,49 @@ TEST(SceneExport, StoredPointsAreOffsetsFromTheirCentroid) {
   const double scale = points["scale"];
   EXPECT_NEAR(map.segments[1].centroid.z() + offsets[3 * 3 + 2] * scale, 3.0, scale);
   EXPECT_NEAR(map.segments[0].centroid.x() + offsets[0] * scale, 9.0, scale);
+}
+
+// A map merged from two drives: each entry's session, and each session's name, number of entries
+// and trajectory (none for the first, which defines the map's frame); the map of one run is one
+// session, "this run"; an entry of a session the map does not have is an error naming it.
+TEST(SceneExport, TheSessionsOfAMergedMapWithTheirEntriesAndTrajectories) {
+  TargetMap map = smallMap();
+  viz::SceneInputs in;
+  in.map = &map;
+  nlohmann::ordered_json j = viz::sceneJson(in);
+  EXPECT_TRUE(j["map"]["sessions"].is_null()) << j["map"]["sessions"];
+  ASSERT_EQ(j["sessions"].size(), 1u) << j["sessions"];
+  EXPECT_EQ(j["sessions"][0]["name"], "this run");
+  EXPECT_EQ(j["sessions"][0]["entries"], 3);
+  EXPECT_TRUE(j["sessions"][0]["trajectory"].is_null());
+
+  map.sessions = {{"sim:world=1,run=S0", 1700000000, {}},
+                  {"sim:world=1,run=S2",
+                   1700086400,
+                   {planarPose(10, 4, 1, 0), planarPose(12, 4, 1, 0), planarPose(14, 5, 1, 0)}}};
+  map.segments[1].session = 1;
+  map.segments[2].session = 1;
+  in.colouring = "session";
+  j = viz::sceneJson(in);
+  EXPECT_EQ(j["colouring"], "session");
+  EXPECT_EQ(decode<uint16_t>(j["map"]["sessions"]), (std::vector<uint16_t>{0, 1, 1}));
+  ASSERT_EQ(j["sessions"].size(), 2u) << j["sessions"];
+  EXPECT_EQ(j["sessions"][0]["name"], "sim:world=1,run=S0");
+  EXPECT_EQ(j["sessions"][0]["entries"], 1);
+  EXPECT_TRUE(j["sessions"][0]["trajectory"].is_null());
+  EXPECT_EQ(j["sessions"][1]["name"], "sim:world=1,run=S2");
+  EXPECT_EQ(j["sessions"][1]["entries"], 2);
+  const auto trajectory = decode<float>(j["sessions"][1]["trajectory"]);  // origin (13, 4, 1)
+  ASSERT_EQ(trajectory.size(), 9u);
+  EXPECT_FLOAT_EQ(trajectory[3], 12 - 13);
+  EXPECT_FLOAT_EQ(trajectory[7], 5 - 4);
+  EXPECT_FLOAT_EQ(trajectory[8], 0);
+
+  map.segments[2].session = 2;
+  map.source = "ab.map";
+  const std::string e = errorOf([&] { viz::sceneJson(in); });
+  EXPECT_MENTIONS(e, "ab.map: segment 2 is of session 2, but the map has 2 sessions");
+  EXPECT_ONE_LINE(e);
 }
 
 TEST(SceneExport, ThePageHoldsTheSceneEscaped) {

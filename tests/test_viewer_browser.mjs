@@ -2,13 +2,16 @@
 // would: waits for it to be ready, reads what it reports (window.semsegmapViewer and the DOM),
 // clicks a localization on the canvas and one in the list, drags the frame slider with the
 // keyboard, takes a screenshot and checks that the 3D canvas is not blank; optionally turns the
-// view for a while and counts the frames drawn. Prints one line of JSON for tests/test_viewer.cpp.
+// view for a while and counts the frames drawn, and optionally picks another colouring in the
+// page's switch first (what the map and its legend show then, and the canvas's pixels of each
+// session's colour). Prints one line of JSON for tests/test_viewer_page.cpp.
 // usage: node test_viewer_browser.mjs NODE_MODULES CHROMIUM PAGE.html SCREENSHOT.png [ROTATE_MS]
+//        [COLOURING]
 import { createRequire } from 'node:module';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 
-const [nodeModules, chromiumPath, pagePath, screenshot, rotateMs = '0'] = process.argv.slice(2);
+const [nodeModules, chromiumPath, pagePath, screenshot, rotateMs = '0', colouring = ''] = process.argv.slice(2);
 const { chromium } = createRequire(path.join(path.resolve(nodeModules), 'noop.js'))('playwright-core');
 
 // Root needs --no-sandbox; the rest keeps Chromium from reaching for the network at start and
@@ -34,6 +37,44 @@ function canvasContent() {
     colours.add((data[i] >> 4) * 256 + (data[i + 1] >> 4) * 16 + (data[i + 2] >> 4));
   }
   return { nonBackground: other / (data.length / 4), colours: colours.size };
+}
+
+// How many of the canvas's pixels are each of `colours` ([r, g, b]; a disc's shading darkens its
+// rim, so within a few levels).
+function pixelsOf(colours) {
+  const canvas = document.getElementById('view');
+  const probe = document.createElement('canvas');
+  [probe.width, probe.height] = [canvas.width, canvas.height];
+  const ctx = probe.getContext('2d');
+  ctx.drawImage(canvas, 0, 0);
+  const data = ctx.getImageData(0, 0, probe.width, probe.height).data;
+  const counts = colours.map(() => 0);
+  for (let i = 0; i < data.length; i += 4)
+    colours.forEach((c, k) => {
+      if (Math.abs(data[i] - c[0]) + Math.abs(data[i + 1] - c[1]) + Math.abs(data[i + 2] - c[2]) <= 24) counts[k]++;
+    });
+  return counts;
+}
+
+// Picks `mode` in the page's colouring switch, as a user does, and reports what the map is drawn
+// in then, the sessions' legend and the canvas's pixels of each session's colour.
+async function switchColouring(page, mode) {
+  const before = await page.evaluate(() => window.semsegmapViewer.mapColours());
+  await page.selectOption('#colouring', mode);
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const after = await page.evaluate(() => {
+    const v = window.semsegmapViewer;
+    const legend = [...document.querySelectorAll('#sessions li')].map((li) => ({
+      session: Number(li.dataset.session), text: li.textContent.trim(),
+      swatch: getComputedStyle(li.querySelector('.swatch')).backgroundColor }));
+    return { selected: document.getElementById('colouring').value, mapColours: v.mapColours(),
+             sessionColours: legend.map((l) => v.sessionColour(l.session)), legend,
+             sessionLegendShown: !document.getElementById('session-legend').hidden,
+             classLegendShown: !document.getElementById('class-legend').hidden,
+             sessionTrajectories: v.sessionTrajectories() };
+  });
+  after.pixels = await page.evaluate(pixelsOf, after.sessionColours);
+  return { mode, before, ...after };
 }
 
 // A localization with matches whose disc is on the canvas, not under a panel: its screen point.
@@ -75,6 +116,7 @@ async function run() {
   }));
   if (out.error) return finish(browser, out, requests, errors, url);
   if (out.stats.localizations > 0) await interact(page, out);
+  if (colouring) out.colouring = await switchColouring(page, colouring);
   await page.screenshot({ path: screenshot });
   out.canvas = await page.evaluate(canvasContent);
   if (Number(rotateMs) > 0) out.rotation = await page.evaluate((ms) => window.semsegmapViewer.measureRotation(ms), Number(rotateMs));

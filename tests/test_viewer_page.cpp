@@ -3,7 +3,8 @@
 // commands as a user types them, its page opened from disk in headless Chromium with the network
 // off (tests/test_viewer_browser.mjs, Playwright), the numbers the page reports checked against
 // the files, a click on a localization showing its matches, the play button and the frame slider,
-// and a screenshot that is not blank;
+// and a screenshot that is not blank; a map merged from two sessions coloured by session in the
+// page's switch (each session in its own colour, its legend entry, its trajectory);
 // and a map of 100k segments, loaded and turned, with its file size, load time and frame rate.
 // A build without the viewer, a machine without Chromium or a Node.js older than 20 (which
 // Playwright needs) skips what it cannot run, saying why.
@@ -85,13 +86,15 @@ std::string browserMissing() {
   return "";
 }
 
-// The page in Chromium (tests/test_viewer_browser.mjs): what it reported, as JSON.
+// The page in Chromium (tests/test_viewer_browser.mjs): what it reported, as JSON; with
+// `colouring`, that colouring picked in the page's switch before the screenshot.
 nlohmann::json openInBrowser(const std::filesystem::path& page, const std::filesystem::path& png,
-                             int rotate_ms, const std::filesystem::path& dir) {
+                             int rotate_ms, const std::filesystem::path& dir,
+                             const std::string& colouring = "") {
   const Result r =
       shell("'" SEMSEGMAP_NODE "' '" + kSource + "/tests/test_viewer_browser.mjs' '" +
                 SEMSEGMAP_VIEWER_NODE_MODULES + "' '" + SEMSEGMAP_CHROMIUM + "' '" + page.string() +
-                "' '" + png.string() + "' " + std::to_string(rotate_ms),
+                "' '" + png.string() + "' " + std::to_string(rotate_ms) + " " + colouring,
             dir);
   EXPECT_EQ(r.code, 0) << r.out << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
@@ -267,6 +270,113 @@ TEST(ViewerPage, TinyWorldOpensOfflineInChromiumAndAClickShowsMatches) {
   EXPECT_GT(colours, 20u) << png;
   std::cout << "page " << std::filesystem::file_size(page) << " bytes, ready in " << j["wallMs"]
             << " ms; screenshot " << png.string() << "\n";
+}
+
+// Two drives past a row of houses: S0 (the map's first session, which defines its frame and has
+// no trajectory) saw 24 segments along y = 0, S2 16 along y = 10 and drove between them; a few
+// classes, so that colouring by class is not one colour either. 8 stored points a segment.
+TargetMap twoSessionMap() {
+  const ClassId classes[] = {cls::kBuilding, cls::kVegetation, cls::kPole, cls::kFence};
+  TargetMap map;
+  map.descriptor = "eigen";
+  map.sessions = {{"sim:world=1,run=S0,preset=tiny", 1700000000, {}},
+                  {"sim:world=1,run=S2,preset=tiny", 1700086400, {}}};
+  for (int k = 0; k <= 40; ++k) map.sessions[1].trajectory.push_back(planarPose(k, 5, 0, 0));
+  for (uint16_t session = 0; session < 2; ++session)
+    for (int i = 0; i < (session == 0 ? 24 : 16); ++i) {
+      MapSegment s;
+      s.centroid = {1.7f * static_cast<float>(i), session == 0 ? 0.0f : 10.0f, 2.0f};
+      s.n_points = 200;
+      s.majority_class = classes[i % 4];
+      for (int p = 0; p < 8; ++p)
+        s.points.push_back(s.centroid + Eigen::Vector3f(0.1f * static_cast<float>(p % 4) - 0.15f,
+                                                        0.3f * static_cast<float>(p / 4), 0.2f));
+      s.segment = static_cast<uint32_t>(map.segments.size());
+      s.session = session;
+      s.keyframe = session == 0 ? 0 : static_cast<uint32_t>(i);
+      map.segments.push_back(s);
+    }
+  map.descriptors = Eigen::MatrixXf::Zero(static_cast<Eigen::Index>(map.size()), 7);
+  return map;
+}
+
+// What the page showed after the switch to session colouring, against the map's sessions: the
+// map drawn in exactly one colour per session (each its entries' points), distinct, each the
+// session's swatch in the legend (name and number of entries) and on the canvas.
+void expectSessionColouring(const nlohmann::json& page, const std::vector<std::string>& names,
+                            const std::vector<size_t>& entries, size_t points_per_entry) {
+  const size_t n = names.size();
+  ASSERT_TRUE(page.contains("colouring")) << page.dump();
+  const nlohmann::json& c = page["colouring"];
+  EXPECT_EQ(page["stats"]["sessions"], n);
+  EXPECT_EQ(c["selected"], "session");
+  EXPECT_TRUE(c["sessionLegendShown"].get<bool>()) << c;
+  EXPECT_FALSE(c["classLegendShown"].get<bool>()) << c;
+  EXPECT_GT(c["before"].size(), n) << "colouring by class drew as few colours as by session";
+  ASSERT_EQ(c["legend"].size(), n) << c["legend"];
+  ASSERT_EQ(c["sessionColours"].size(), n) << c;
+  ASSERT_EQ(c["mapColours"].size(), n) << c["mapColours"];  // [r, g, b, count], most first
+  std::set<std::vector<int>> distinct;
+  for (size_t k = 0; k < n; ++k) {
+    const nlohmann::json& item = c["legend"][k];
+    EXPECT_EQ(item["session"], k);
+    const std::string text = item["text"].get<std::string>();
+    EXPECT_NE(text.find(names[k]), std::string::npos) << text;
+    EXPECT_EQ(text.substr(text.rfind(' ') + 1), std::to_string(entries[k])) << text;
+    const auto rgb = c["sessionColours"][k].get<std::vector<int>>();
+    ASSERT_EQ(rgb.size(), 3u);
+    distinct.insert(rgb);
+    EXPECT_EQ(item["swatch"], "rgb(" + std::to_string(rgb[0]) + ", " + std::to_string(rgb[1]) +
+                                  ", " + std::to_string(rgb[2]) + ")");
+    size_t drawn = 0;  // the map's points in this session's colour
+    for (const nlohmann::json& m : c["mapColours"])
+      if (std::vector<int>{m[0].get<int>(), m[1].get<int>(), m[2].get<int>()} == rgb)
+        drawn = m[3].get<size_t>();
+    EXPECT_EQ(drawn, entries[k] * points_per_entry) << "session " << k << ": " << c["mapColours"];
+    EXPECT_GT(c["pixels"][k].get<int>(), 20) << "session " << k << " is not on the canvas";
+  }
+  EXPECT_EQ(distinct.size(), n) << c["sessionColours"];
+}
+
+TEST(ViewerPage, ColouredBySessionEachSessionHasItsColourItsLegendEntryAndItsTrajectory) {
+  const std::string missing = browserMissing();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  TempDir tmp;
+  TargetMap map = twoSessionMap();
+  const std::filesystem::path map_path = tmp.path() / "s02.map", page = tmp.path() / "s02.html";
+  saveTargetMap(map_path, map);
+  const Result v =
+      semsegmap("view --map " + map_path.string() + " --out " + page.string(), tmp.path());
+  ASSERT_EQ(v.code, 0) << v.err;
+  const std::string html = readFile(page);
+  for (const MapSession& s : map.sessions)
+    EXPECT_NE(html.find("\"" + s.name + "\""), std::string::npos) << s.name;
+  std::filesystem::create_directories(kScreenshots);
+  const std::filesystem::path png = kScreenshots / "viewer_sessions.png";
+  const nlohmann::json j = openInBrowser(page, png, 0, tmp.path(), "session");
+  ASSERT_FALSE(j.contains("failed")) << j.dump();
+  ASSERT_TRUE(j["error"].is_null()) << j["error"];
+  EXPECT_EQ(j["pageErrors"].size(), 0u) << j["pageErrors"];
+  ASSERT_NO_FATAL_FAILURE(
+      expectSessionColouring(j, {map.sessions[0].name, map.sessions[1].name}, {24, 16}, 8));
+  // S0 defines the map's frame and has no trajectory: S2's alone is drawn.
+  EXPECT_EQ(j["colouring"]["sessionTrajectories"], 1);
+  EXPECT_GT(screenshotContent(png).first, 0.002) << png;
+  std::cout << "screenshot " << png.string() << "\n";
+
+  // The map of one run: one session, "this run", all its entries in one colour.
+  map.sessions.clear();
+  for (MapSegment& s : map.segments) s.session = 0;
+  saveTargetMap(map_path, map);
+  const Result one =
+      semsegmap("view --map " + map_path.string() + " --out " + page.string(), tmp.path());
+  ASSERT_EQ(one.code, 0) << one.err;
+  const nlohmann::json single =
+      openInBrowser(page, tmp.path() / "one.png", 0, tmp.path(), "session");
+  ASSERT_FALSE(single.contains("failed")) << single.dump();
+  ASSERT_TRUE(single["error"].is_null()) << single["error"];
+  ASSERT_NO_FATAL_FAILURE(expectSessionColouring(single, {"this run"}, {40}, 8));
+  EXPECT_EQ(single["colouring"]["sessionTrajectories"], 0);
 }
 
 // A map the size of a city: 100k segments over 1.6 x 1.6 km, with `points` stored points each.

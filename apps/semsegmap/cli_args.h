@@ -115,6 +115,12 @@ const CommandSpec& slamCommand();
 const CommandSpec& odometryCommand();
 const CommandSpec& trainCommand();
 const CommandSpec& trainSegmentationCommand();  // a build with libtorch
-const CommandSpec& viewCommand();               // a build with the viewer (SEMSEGMAP_WITH_VIEWER)
+// `maps list|show|export|import|drop`: a build with the PostgreSQL map store.
+const CommandSpec& mapsListCommand();
+const CommandSpec& mapsShowCommand();
+const CommandSpec& mapsExportCommand();
+const CommandSpec& mapsImportCommand();
+const CommandSpec& mapsDropCommand();
+const CommandSpec& viewCommand();  // a build with the viewer (SEMSEGMAP_WITH_VIEWER)
 
 }  // namespace semsegmap::app

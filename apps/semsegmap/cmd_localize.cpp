@@ -23,6 +23,8 @@
 #include "semsegmap/pipeline/map_parameters.h"
 #include "semsegmap/pipeline/modes.h"
 #include "semsegmap/settings/config.h"
+#include "semsegmap/store/map_location.h"
+#include "semsegmap/store/map_store_uri.h"
 
 namespace semsegmap::app {
 
@@ -87,7 +89,7 @@ int runLocalize(const CliArgs& a) {
   const std::optional<RelocalizationPrior> prior = priorOf(a, config);
   const std::filesystem::path map_path = a.get("map");
   const std::filesystem::path out = a.get("out");
-  const auto map = std::make_shared<const TargetMap>(loadTargetMap(map_path));
+  const auto map = std::make_shared<const TargetMap>(loadMapAt(map_path.string()));
   // The map's recorded build settings against the configuration's, before the data is opened;
   // with --allow-config-mismatch the session warns of each difference instead.
   const MapSettingsCheck settings =
@@ -144,15 +146,17 @@ void writeLocalizeFiles(const CliArgs& a, const LocalizationRun& run, const Targ
   writeLocalizationsCsv(out / "localizations.csv", run);
   writeLocalizationDetails(out, run);  // matches.csv, trajectory.csv: for semsegmap view
   writeLocalizationPicture(out / "localization.png", run, map,
-                           dataset + " against " + map_path.filename().string() + " (" +
+                           dataset + " against " + mapDisplayName(map_path.string()) + " (" +
                                std::filesystem::path(a.get("config")).stem().string() + ")");
   SummaryContext context;
   context.dataset = dataset;
-  context.map = map_path.string();
+  // A store's map: its URI without the password, and no file size.
+  const bool stored = isMapStoreUri(map_path.string());
+  context.map = stored ? map.source : map_path.string();
   context.config = a.get("config");
   context.descriptor = map.descriptor;
   context.map_segments = map.size();
-  context.map_bytes = std::filesystem::file_size(map_path);
+  context.map_bytes = stored ? 0 : std::filesystem::file_size(map_path);
   writeBytesAtomically(out / "summary.json", localizationSummaryJson(run, context));
 }
 
@@ -172,7 +176,10 @@ const CommandSpec& localizeCommand() {
           {
               {"config", Value::kText, "FILE", "",
                "pipeline configuration, the one the map was built with", kRequired},
-              {"map", Value::kText, "MAP", "", "the target map (semsegmap map)", kRequired},
+              {"map", Value::kText, "MAP", "",
+               "the target map (semsegmap map): a file, or postgresql://...?map=NAME"
+               "[&region=X,Y,RADIUS] (docs/map-store.md)",
+               kRequired},
               {"out", Value::kText, "DIR", "", "output folder", kRequired},
               maxFramesOption(),
               {"allow-config-mismatch", Value::kFlag, "", "",

@@ -32,7 +32,7 @@ std::pair<int, int> inputSize(const CliArgs& a) {
   return {w, h};
 }
 
-SegTrainConfig trainConfig(const CliArgs& a) {
+SegTrainConfig segmentationTrainConfig(const CliArgs& a) {
   SegTrainConfig c;
   std::tie(c.input_width, c.input_height) = inputSize(a);
   // The crop is 3/5 of the input each way, a multiple of 8 (192x144 of 320x240).
@@ -119,7 +119,7 @@ SegTrainCallbacks callbacks(const CliArgs& a, const SegTrainConfig& c,
 }
 
 int runTrainSegmentation(const CliArgs& a) {
-  const SegTrainConfig config = trainConfig(a);
+  const SegTrainConfig config = segmentationTrainConfig(a);
   const std::filesystem::path out = a.get("out");
   const auto start = std::chrono::steady_clock::now();
   std::vector<LabelledPicture> pictures;

@@ -8,6 +8,7 @@
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/diagnostics.h"
+#include "semsegmap/store/map_location.h"
 #include "semsegmap/viz/scene_export.h"
 #include "viewer_asset.h"
 
@@ -17,7 +18,7 @@ namespace {
 
 // "tiny.map · S2 (sim:...)": what the page's title says when none is given.
 std::string titleOf(const ViewSources& s, const LocalizationFolder* localization) {
-  std::string title = s.map.filename().string();
+  std::string title = mapDisplayName(s.map.string());
   if (localization)
     title += " · " + (localization->dataset.empty() ? localization->dir.filename().string()
                                                     : localization->dataset);
@@ -49,7 +50,7 @@ int runView(const CliArgs& a) {
 }  // namespace
 
 uint64_t writeViewPage(const ViewSources& s, const std::filesystem::path& out) {
-  const TargetMap map = loadTargetMap(s.map);
+  const TargetMap map = loadMapAt(s.map.string());
   std::optional<LocalizationFolder> localization;
   std::optional<SlamFolder> slam;
   std::optional<SegmentFolder> segments;
@@ -62,7 +63,7 @@ uint64_t writeViewPage(const ViewSources& s, const std::filesystem::path& out) {
          "shows no matched segments");
   viz::SceneInputs in;
   in.title = s.title.empty() ? titleOf(s, localization ? &*localization : nullptr) : s.title;
-  in.map_name = s.map.filename().string();
+  in.map_name = mapDisplayName(s.map.string());
   in.map = &map;
   in.localization = localization ? &*localization : nullptr;
   in.slam = slam ? &*slam : nullptr;
@@ -78,12 +79,14 @@ const CommandSpec& viewCommand() {
       "view",
       "a map and its runs in 3D in the browser -> one self-contained .html (offline)",
       {
-          {"map", Value::kText, "MAP", "", "the target map (semsegmap map)", kRequired},
+          {"map", Value::kText, "MAP", "",
+           "the target map: a file, or postgresql://...?map=NAME[&region=X,Y,RADIUS]", kRequired},
           {"localization", Value::kText, "DIR", "",
            "a localization run against it (semsegmap localize, eval, demo)"},
           {"slam", Value::kText, "DIR", "", "a loop-closure run (semsegmap slam)"},
           {"segments", Value::kText, "DIR", "", "a segmentation run (semsegmap segment)"},
-          {"colour", Value::kText, "class|segment", "class", "how the segments are coloured first"},
+          {"colour", Value::kText, "class|segment|session", "class",
+           "how the segments are coloured first"},
           {"title", Value::kText, "TEXT", "", "the page's title (default: the map and run names)"},
           {"out", Value::kText, "FILE.html", "", "the page to write", kRequired},
       },

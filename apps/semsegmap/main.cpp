@@ -14,6 +14,7 @@
 #include "progress.h"
 #include "semsegmap/core/diagnostics.h"
 #include "semsegmap/outputs/run_output.h"
+#include "semsegmap/store/map_store_uri.h"
 #if SEMSEGMAP_WITH_TORCH
 #include "semsegmap/describe/learned_describer.h"
 #endif
@@ -40,6 +41,10 @@ const std::vector<const CommandSpec*>& commands() {
 #endif
 #if SEMSEGMAP_WITH_VIEWER
     c.push_back(&viewCommand());
+#endif
+#if SEMSEGMAP_WITH_POSTGRES
+    c.insert(c.end(), {&mapsListCommand(), &mapsShowCommand(), &mapsExportCommand(),
+                       &mapsImportCommand(), &mapsDropCommand()});
 #endif
 #if SEMSEGMAP_WITH_SIM
     c.push_back(&demoCommand());
@@ -89,6 +94,11 @@ const std::vector<AbsentCommand>& absentCommands() {
       a.push_back({"train-segmentation", "SEMSEGMAP_WITH_TORCH",
                    "this build has no segmentation network training (built without libtorch, "
                    "reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)"});
+    if (!SEMSEGMAP_WITH_POSTGRES)
+      for (const char* name : {"maps list", "maps show", "maps export", "maps import", "maps drop"})
+        a.push_back({name, "SEMSEGMAP_WITH_POSTGRES",
+                     "this build has no PostgreSQL map store (built without libpq, reconfigure "
+                     "with -DSEMSEGMAP_WITH_POSTGRES=ON)"});
     if (!SEMSEGMAP_WITH_VIEWER)
       a.push_back({"view", "SEMSEGMAP_WITH_VIEWER",
                    "this build has no viewer (built without Node.js and npm: run "
@@ -151,7 +161,9 @@ bool asksForHelp(const std::vector<std::string>& args) {
 // itself.
 std::vector<std::string> firstWords() {
   std::vector<std::string> words = {"eval", "--help", "--version", "--check-usage"};
-  for (const CommandSpec* c : commands()) words.push_back(c->name);
+  for (const CommandSpec* c : commands())
+    if (std::find(words.begin(), words.end(), c->name.substr(0, c->name.find(' '))) == words.end())
+      words.push_back(c->name.substr(0, c->name.find(' ')));
   for (const AbsentCommand& c : absentCommands())
     if (c.name.find(' ') == std::string::npos) words.push_back(c.name);
   return words;
@@ -169,11 +181,14 @@ UsageError unknownExperiment(const std::string& typed) {
 // The command `args` names (one word, or two after `eval`); `name` is set to what was found so
 // far, for the error messages. Throws UsageError for an unknown one.
 const CommandSpec* findCommand(const std::vector<std::string>& args, std::string* name) {
+  const std::string two_words = args.size() > 1 ? args[0] + " " + args[1] : "";
   for (const CommandSpec* c : commands()) {
-    if (c->name != args[0]) continue;
+    if (c->name != args[0] && c->name != two_words) continue;
     *name = c->name;
     return c;
   }
+  if (args[0] == "maps" && SEMSEGMAP_WITH_POSTGRES)
+    throw UsageError("maps needs an action: list, show, export, import or drop");
   if (args[0] != "eval")
     throw UsageError("unknown command '" + args[0] + "'" + didYouMean(args[0], firstWords()));
   *name = "eval";
@@ -211,6 +226,7 @@ void declareOutputs(const CliArgs& a, RunOutputs& outputs) {
     if (o.name == "cache" && a.has("cache")) outputs.keptFile(a.get("cache"), "--cache");
     if (!isOutput(o) || (!a.has(o.name) && o.fallback.empty())) continue;
     const std::string option = "--" + o.name, path = a.get(o.name);
+    if (isMapStoreUri(path)) continue;  // a map in a store: written in one transaction
     const bool folder = o.placeholder == "DIR";
     const size_t before = folder ? outputs.folder(path, option) : outputs.file(path, option);
     if (before > 0) replaced.push_back(replacedNote(option, path, before, folder));

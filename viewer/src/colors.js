@@ -1,5 +1,6 @@
-// Colours: classes from the class table (unknown excepted), segments by a hash of their index, localizations by
-// their error (the bird's-eye pictures' scale: green within 0.5 m, red beyond 5 m).
+// Colours: classes from the class table (unknown excepted), segments by a hash of their index, sessions from a
+// fixed qualitative palette, localizations by their error (the bird's-eye pictures' scale: green within 0.5 m, red
+// beyond 5 m).
 
 // Class unknown (id 0: what no camera saw, and all of a LiDAR-only map) is black in the class
 // table, which the overlays draw over camera pictures; on this page's near-black background it
@@ -18,6 +19,22 @@ export function segmentColor(index) {
   const h = (index * 0.618033988749895) % 1;
   const l = index % 2 ? 0.55 : 0.7;
   return hslToRgb(h, 0.75, l);
+}
+
+// Okabe and Ito's colour-blind safe palette, bright enough on the dark background (its black left out), session 0
+// first; sessions beyond it take hues a golden angle apart.
+export const SESSION_COLORS = [
+  [86, 180, 233],   // sky blue
+  [230, 159, 0],    // orange
+  [0, 158, 115],    // bluish green
+  [240, 228, 66],   // yellow
+  [213, 94, 0],     // vermillion
+  [204, 121, 167],  // reddish purple
+  [0, 114, 178],    // blue
+];
+
+export function sessionColor(index) {
+  return index < SESSION_COLORS.length ? SESSION_COLORS[index] : segmentColor(index);
 }
 
 function hslToRgb(h, s, l) {

@@ -1,6 +1,6 @@
 // semsegmap view's page: reads the scene embedded in the file, builds the 3D view and the panel,
 // and exposes window.semsegmapViewer for scripts and tests (README.md).
-import { classColor } from './colors.js';
+import { classColor, sessionColor } from './colors.js';
 import { decodeScene } from './scene.js';
 import { Viewer } from './view3d.js';
 import { Panel } from './panel.js';
@@ -37,6 +37,7 @@ function expose(scene, viewer, panel) {
       segmentRunSegments: scene.segments ? scene.segments.segments : 0,
       segmentRunPoints: scene.segments ? scene.segments.points.positions.length / 3 : 0,
       loops: scene.slam ? scene.slam.loops.length : 0,
+      sessions: scene.sessions.length,
       frames: panel.frames ? panel.frames.length : 0,
     },
     layers: () => Object.keys(viewer.layers),
@@ -44,7 +45,10 @@ function expose(scene, viewer, panel) {
       : { index: panel.selected, frame: records[panel.selected].frame, matches: viewer.shownMatches }),
     select: (i) => panel.choose(i),
     setRow: (row) => panel.setRow(row),
-    setColouring: (mode) => viewer.setColouring(mode),
+    setColouring: (mode) => panel.setColouring(mode),
+    mapColours: () => viewer.mapColours(),
+    sessionColour: (i) => sessionColor(i),
+    sessionTrajectories: () => viewer.shownSessionTrajectories(),
     screenPositionOfLocalization: (i) => viewer.screenPosition(records[i].position),
     matchesOf: (i) => records[i].matches.length,
     classColour: (id) => classColor(scene.classes, id),

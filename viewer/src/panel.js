@@ -1,6 +1,7 @@
-// The page around the 3D view: title and counts, colouring and layer switches, the class legend,
-// the frame slider with its play button, the selected localization and the list of all of them.
-import { classColor, css, ERROR_STOPS, errorColor } from './colors.js';
+// The page around the 3D view: title and counts, colouring and layer switches, the class legend
+// (or the sessions' when the map is coloured by session), the frame slider with its play button,
+// the selected localization and the list of all of them.
+import { classColor, css, ERROR_STOPS, errorColor, sessionColor } from './colors.js';
 
 const $ = (id) => document.getElementById(id);
 const fmt = (v, digits = 2) => (v === null || v === undefined ? '–' : v.toFixed(digits));
@@ -40,6 +41,8 @@ export class Panel {
     this.buildColouring();
     this.buildLayers();
     this.buildLegend();
+    this.buildSessionLegend();
+    this.showLegendOf(this.viewer.mapColouring);
     this.buildErrorLegend();
     if (!scene.localization) return $('side').remove();  // nothing to step through or select
     this.buildList();
@@ -53,6 +56,7 @@ export class Panel {
     stats.dataset.segments = s.map.count;
     stats.dataset.localizations = this.records.length;
     const parts = [`${s.map.count} map segments`];
+    if (s.sessions.length > 1) parts.push(`${s.sessions.length} sessions`);
     if (s.map.points) parts.push(`${s.map.points.positions.length / 3} stored points`);
     if (s.localization) parts.push(`${this.records.length} localizations`);
     if (s.segments) parts.push(`${s.segments.segments} segments of ${s.segments.name}`);
@@ -62,10 +66,23 @@ export class Panel {
 
   buildColouring() {
     const select = $('colouring');
-    const modes = ['class', 'segment'].concat(this.scene.segments ? ['camera'] : []);
+    const modes = ['class', 'segment', 'session'].concat(this.scene.segments ? ['camera'] : []);
     for (const m of modes) select.append(element('option', { value: m }, m));
     select.value = this.viewer.colouring;
-    select.addEventListener('change', () => this.viewer.setColouring(select.value));
+    select.addEventListener('change', () => this.setColouring(select.value));
+  }
+
+  setColouring(mode) {
+    $('colouring').value = mode;
+    this.viewer.setColouring(mode);
+    this.showLegendOf(this.viewer.mapColouring);
+  }
+
+  // The legend of what the map's colours mean: its sessions when coloured by session, else its
+  // classes.
+  showLegendOf(mapColouring) {
+    $('session-legend').hidden = mapColouring !== 'session';
+    $('class-legend').hidden = mapColouring === 'session';
   }
 
   buildLayers() {
@@ -93,6 +110,18 @@ export class Panel {
                   element('span', { class: 'count' }, String(n)));
       legend.append(item);
     }
+  }
+
+  // The sessions the map was merged from, in order (the map of one run: "this run"), with their
+  // numbers of entries.
+  buildSessionLegend() {
+    const legend = $('sessions');
+    this.scene.sessions.forEach((s, k) => {
+      const item = element('li', { 'data-session': k });
+      item.append(swatch(sessionColor(k)), ' ', element('span', { class: 'name' }, s.name), ' ',
+                  element('span', { class: 'count' }, String(s.entries)));
+      legend.append(item);
+    });
   }
 
   buildErrorLegend() {

@@ -2,7 +2,7 @@
 // arrays: positions relative to scene.origin, points rebuilt from their 16-bit offsets.
 
 const SCENE_FORMAT = 'semsegmap-scene';
-const SCENE_VERSION = 1;
+const SCENE_VERSION = 2;
 
 function bytesOf(b64) {
   if (typeof Uint8Array.fromBase64 === 'function') return Uint8Array.fromBase64(b64);
@@ -45,6 +45,7 @@ function decodeMap(map) {
     centroids,
     classes: decode(map.classes, Uint16Array),
     sizes: decode(map.sizes, Uint32Array),
+    sessions: decode(map.sessions, Uint16Array),  // null: the map of one run, all session 0
     points: map.points ? pointGroups(map.points, centroids) : null,
   };
 }
@@ -85,6 +86,7 @@ export function decodeScene(json) {
     origin: json.origin,
     classes: new Map(json.classes.map((c) => [c.id, c])),
     map: decodeMap(json.map),
+    sessions: json.sessions.map((s) => ({ ...s, trajectory: decode(s.trajectory, Float32Array) })),
     localization: json.localization && decodeLocalization(json.localization),
     slam: json.slam && {
       ...json.slam,

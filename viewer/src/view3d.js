@@ -1,11 +1,15 @@
-// The 3D scene: one THREE object per layer (map, segmentation run, trajectories, localizations,
-// the selected localization's matches, the SLAM run), drawn only when something changed.
+// The 3D scene: one THREE object per layer (map, the map's sessions' trajectories, segmentation
+// run, trajectories, localizations, the selected localization's matches, the SLAM run), drawn
+// only when something changed.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { discs, fillColors, setViewport } from './discs.js';
-import { classColor, errorColor, segmentColor } from './colors.js';
+import { classColor, errorColor, segmentColor, sessionColor } from './colors.js';
 
 const FOV = 50;
+const MAP_COLOURINGS = ['class', 'segment', 'session'];
+
+const hex = ([r, g, b]) => (r << 16) | (g << 8) | b;
 
 function line(positions, color) {
   const g = new THREE.BufferGeometry();
@@ -48,8 +52,10 @@ export class Viewer {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.addEventListener('change', () => this.requestRender());
     this.layers = {};
-    this.colouring = scene.colouring === 'segment' ? 'segment' : 'class';
+    this.colouring = MAP_COLOURINGS.includes(scene.colouring) ? scene.colouring : 'class';
+    this.mapColouring = this.colouring;  // the camera colouring leaves the map as it was
     this.buildMap();
+    this.buildSessionTrajectories();
     this.buildSegmentRun();
     this.buildLocalizations();
     this.buildSlam();
@@ -82,11 +88,47 @@ export class Viewer {
     const m = this.scene.map;
     const classes = this.scene.classes;
     const segmentOf = m.points ? (i) => m.points.group[i] : (i) => i;
+    const sessionOf = m.sessions ? (s) => m.sessions[s] : () => 0;
     const n = this.mapColors.length / 3;
-    fillColors(this.mapColors, n, (i) => this.colouring === 'segment'
-      ? segmentColor(segmentOf(i))
-      : classColor(classes, m.classes[segmentOf(i)]));
+    fillColors(this.mapColors, n, (i) => {
+      const s = segmentOf(i);
+      if (this.mapColouring === 'segment') return segmentColor(s);
+      if (this.mapColouring === 'session') return sessionColor(sessionOf(s));
+      return classColor(classes, m.classes[s]);
+    });
     this.layers.map.geometry.attributes.rgb.needsUpdate = true;
+    if (this.sessionLines) this.sessionLines.visible = this.mapColouring === 'session';
+  }
+
+  // Each session's trajectory in its colour, shown while the map is coloured by session (the
+  // first session has none: it defines the map's frame).
+  buildSessionTrajectories() {
+    const tracks = new THREE.Group();
+    this.scene.sessions.forEach((s, k) => {
+      if (s.trajectory && s.trajectory.length >= 6) tracks.add(line(s.trajectory, hex(sessionColor(k))));
+    });
+    if (!tracks.children.length) return;
+    this.sessionLines = tracks;
+    this.sessionLines.visible = this.mapColouring === 'session';
+    const layer = new THREE.Group();  // switched by its checkbox, the lines inside by the colouring
+    layer.add(tracks);
+    this.add('session trajectories', onTop(layer, 1));
+  }
+
+  // How many sessions' trajectories are drawn now.
+  shownSessionTrajectories() {
+    const l = this.sessionLines;
+    return l && l.visible && this.layers['session trajectories'].visible ? l.children.length : 0;
+  }
+
+  // The map's colours as drawn: [r, g, b, how many points or centroids], most frequent first.
+  mapColours() {
+    const counts = new Map();
+    for (let i = 0; i < this.mapColors.length; i += 3) {
+      const key = `${this.mapColors[i]},${this.mapColors[i + 1]},${this.mapColors[i + 2]}`;
+      counts.set(key, (counts.get(key) || 0) + 1);
+    }
+    return [...counts].sort((a, b) => b[1] - a[1]).map(([key, n]) => [...key.split(',').map(Number), n]);
   }
 
   buildSegmentRun() {
@@ -112,7 +154,10 @@ export class Viewer {
 
   setColouring(mode) {
     this.colouring = mode;
-    if (mode !== 'camera') this.colourMap();
+    if (mode !== 'camera') {
+      this.mapColouring = mode;
+      this.colourMap();
+    }
     this.colourSegmentRun();
     this.requestRender();
   }

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "semsegmap/artefacts/map_codec.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/binary_io.h"
 
@@ -21,18 +22,8 @@ constexpr uint32_t kFlagFloat16 = 1u << 0;
 constexpr uint32_t kFlagPoints = 1u << 1;
 constexpr uint32_t kFlagScanContexts = 1u << 2;
 constexpr uint32_t kFlagSessions = 1u << 3;
-// A scan context grid finer than this is a corrupt header, refused before allocating it.
-constexpr uint16_t kMaxScanContextBins = 1024;
 // A map records a few dozen settings; more is a corrupt count, refused before reading on.
 constexpr uint16_t kMaxParameters = 1024;
-
-void putHalf(BinaryWriter& w, float v) {
-  w.put(Eigen::numext::bit_cast<uint16_t>(Eigen::half(v)));
-}
-float getHalf(BinaryReader& r, const char* field) {
-  return static_cast<float>(
-      Eigen::half(Eigen::half_impl::raw_uint16_to_half(r.get<uint16_t>(field))));
-}
 
 void putParameters(BinaryWriter& w, const std::filesystem::path& path, const MapParameters& p) {
   if (p.size() > kMaxParameters)
@@ -64,104 +55,9 @@ MapParameters getParameters(BinaryReader& r) {
   return p;
 }
 
-// A NaN centroid or descriptor matches nothing and a NaN distance sorts anywhere: such a map
-// localized nothing and reported "mean error 0.00 m" instead of failing. Empty when all is finite.
-std::string firstNonFinite(const TargetMap& map) {
-  for (size_t i = 0; i < map.segments.size(); ++i) {
-    const MapSegment& s = map.segments[i];
-    const std::string segment = "segment " + std::to_string(i) + ": non-finite ";
-    if (!s.centroid.allFinite()) return segment + "centroid";
-    if (!map.descriptors.row(static_cast<Eigen::Index>(i)).allFinite())
-      return segment + "descriptor";
-    for (const Eigen::Vector3f& p : s.points)
-      if (!p.allFinite()) return segment + "point";
-  }
-  return {};
-}
-
-// A pose as float64 x, y, z and a float32 unit quaternion w, x, y, z (40 bytes).
-void putPose(BinaryWriter& w, const Pose& T) {
-  const Eigen::Vector3d t = T.translation();
-  const Eigen::Quaterniond q(T.linear());
-  for (int k = 0; k < 3; ++k) w.put<double>(t[k]);
-  for (double v : {q.w(), q.x(), q.y(), q.z()}) w.put<float>(static_cast<float>(v));
-}
-
-// `what` names the pose in the error ("scan context 3").
-Pose getPose(BinaryReader& r, const std::string& what) {
-  Pose T = Pose::Identity();
-  for (int k = 0; k < 3; ++k) T.translation()[k] = r.get<double>(what.c_str());
-  double q[4];
-  for (double& v : q) v = r.get<float>(what.c_str());
-  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
-  if (!T.translation().allFinite() || !(std::abs(rotation.norm() - 1.0) < 1e-3))
-    r.fail(what + ": not a pose");
-  T.linear() = rotation.normalized().toRotationMatrix();
-  return T;
-}
-
-// The scan contexts (flag bit 2): the grid, then per scan its frame and its bins as float16.
-void putScanContexts(BinaryWriter& w, const ScanContextDatabase& db) {
-  const ScanContextConfig& c = db.config();
-  w.put<uint16_t>(static_cast<uint16_t>(c.rings));
-  w.put<uint16_t>(static_cast<uint16_t>(c.sectors));
-  w.put<float>(static_cast<float>(c.max_radius_m));
-  w.put<float>(static_cast<float>(c.height_offset_m));
-  w.put<uint64_t>(db.size());
-  for (const ScanContextDatabase::MappedScan& s : db.scans()) {
-    putPose(w, s.T_world_scan);
-    for (Eigen::Index i = 0; i < s.context.bins.size(); ++i) putHalf(w, s.context.bins(i));
-  }
-}
-
-ScanContextDatabase getScanContexts(BinaryReader& r) {
-  ScanContextConfig c;
-  c.rings = r.get<uint16_t>("the scan contexts");
-  c.sectors = r.get<uint16_t>("the scan contexts");
-  c.max_radius_m = r.get<float>("the scan contexts");
-  c.height_offset_m = r.get<float>("the scan contexts");
-  if (c.rings == 0 || c.sectors == 0 || c.rings > kMaxScanContextBins ||
-      c.sectors > kMaxScanContextBins || !(c.max_radius_m > 0) || !std::isfinite(c.max_radius_m) ||
-      !std::isfinite(c.height_offset_m))
-    r.fail("implausible scan context grid " + std::to_string(c.rings) + " x " +
-           std::to_string(c.sectors));
-  const size_t bins = c.rings * c.sectors;
-  const uint64_t n = r.getCount(24 + 16 + 2 * bins, "the scan contexts");
-  ScanContextDatabase db(c);
-  for (uint64_t i = 0; i < n; ++i) {
-    const Pose T = getPose(r, "scan context " + std::to_string(i));
-    Eigen::MatrixXf b(c.rings, c.sectors);
-    for (Eigen::Index k = 0; k < b.size(); ++k) b(k) = getHalf(r, "a scan context");
-    if (!b.allFinite() || (b.array() < 0).any())
-      r.fail("scan context " + std::to_string(i) + ": a non-finite or negative bin");
-    db.add(scanContextOfBins(std::move(b)), T);
-  }
-  return db;
-}
-
-// Every segment's session exists and its keyframe lies within that session's trajectory (a
-// session without one, the map's first, has keyframe 0 alone). Empty when all do.
-std::string firstOutOfSession(const TargetMap& map) {
-  for (size_t i = 0; i < map.segments.size(); ++i) {
-    const MapSegment& s = map.segments[i];
-    const std::string segment = "segment " + std::to_string(i) + ": ";
-    if (s.session >= map.sessions.size())
-      return segment + "session " + std::to_string(s.session) + " of " +
-             std::to_string(map.sessions.size());
-    const size_t frames = map.sessions[s.session].trajectory.size();
-    if (s.keyframe >= std::max<size_t>(frames, 1))
-      return segment + "keyframe " + std::to_string(s.keyframe) + " of a trajectory of " +
-             std::to_string(frames);
-  }
-  return {};
-}
-
 // The sessions (flag bit 3): each one's name, time and trajectory, then per segment its segment
 // id, session and keyframe.
-void putSessions(BinaryWriter& w, const std::filesystem::path& path, const TargetMap& map) {
-  // Refused here because the loader refuses it: a saved map always reads back.
-  if (const std::string bad = firstOutOfSession(map); !bad.empty())
-    throw std::invalid_argument(path.string() + ": " + bad);
+void putSessions(BinaryWriter& w, const TargetMap& map) {
   w.put<uint16_t>(static_cast<uint16_t>(map.sessions.size()));
   for (const MapSession& s : map.sessions) {
     w.putString32(s.name);
@@ -200,12 +96,8 @@ void getSessions(BinaryReader& r, TargetMap& map) {
 
 uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
                        const MapWriteOptions& options) {
-  if (static_cast<size_t>(map.descriptors.rows()) != map.segments.size())
-    throw std::invalid_argument(path.string() + ": map has " + std::to_string(map.segments.size()) +
-                                " segments but " + std::to_string(map.descriptors.rows()) +
-                                " descriptors");
   // Refused here because the loader refuses it: a saved map always reads back.
-  if (const std::string bad = firstNonFinite(map); !bad.empty())
+  if (const std::string bad = firstUnsavable(map); !bad.empty())
     throw std::invalid_argument(path.string() + ": " + bad);
   bool points = false;
   for (const MapSegment& s : map.segments) points = points || !s.points.empty();
@@ -214,8 +106,6 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
   w.put<uint32_t>(kMapFormatVersion);
   const bool scan_contexts = map.scan_contexts.size() > 0;
   const bool sessions = !map.sessions.empty();
-  if (map.sessions.size() > 65535)
-    throw std::invalid_argument(path.string() + ": more than 65535 sessions");
   w.put<uint32_t>((options.float16 ? kFlagFloat16 : 0u) | (points ? kFlagPoints : 0u) |
                   (scan_contexts ? kFlagScanContexts : 0u) | (sessions ? kFlagSessions : 0u));
   w.putString8(map.descriptor);
@@ -238,14 +128,11 @@ uint64_t saveTargetMap(const std::filesystem::path& path, const TargetMap& map,
   }
   if (points)
     for (const MapSegment& s : map.segments) {
-      if (s.points.size() > 65535) throw std::invalid_argument("more than 65535 picture points");
-      w.put<uint16_t>(static_cast<uint16_t>(s.points.size()));
-      // Offsets from the centroid: float16 keeps centimetres within tens of metres.
-      for (const Eigen::Vector3f& p : s.points)
-        for (int k = 0; k < 3; ++k) putHalf(w, p[k] - s.centroid[k]);
+      w.put<uint16_t>(static_cast<uint16_t>(s.points.size()));  // firstUnsavable: <= 65535
+      putPoints(w, s);
     }
   if (scan_contexts) putScanContexts(w, map.scan_contexts);
-  if (sessions) putSessions(w, path, map);
+  if (sessions) putSessions(w, map);
   w.putChecksum();
   writeBytesAtomically(path, w.bytes());
   return w.bytes().size();
@@ -287,11 +174,7 @@ TargetMap loadTargetMap(const std::filesystem::path& path) {
   }
   if (flags & kFlagPoints)
     for (MapSegment& s : map.segments) {
-      const size_t count = r.get<uint16_t>("the points");
-      r.need(count, 6, "the points");
-      s.points.resize(count);
-      for (Eigen::Vector3f& p : s.points)
-        for (int k = 0; k < 3; ++k) p[k] = s.centroid[k] + getHalf(r, "the points");
+      getPoints(r, r.get<uint16_t>("the points"), s);
     }
   if (flags & kFlagScanContexts) map.scan_contexts = getScanContexts(r);
   if (flags & kFlagSessions)

@@ -117,8 +117,43 @@ Json mapJson(const SceneInputs& in, const Eigen::Vector3d& origin) {
       {"name", in.map_name},     {"descriptor", map.descriptor},   {"segments", map.size()},
       {"stored_points", points}, {"centroids", base64(centroids)}, {"classes", base64(classes)},
       {"sizes", base64(sizes)}};
+  // Each segment's session (uint16), none for the map of one run: all its segments are session 0.
+  std::vector<uint16_t> sessions;
+  if (!map.sessions.empty())
+    for (const MapSegment& s : map.segments) sessions.push_back(s.session);
+  j["sessions"] = map.sessions.empty() ? Json(nullptr) : Json(base64(sessions));
   j["points"] = points > 0 ? pointGroupsJson(local_centroids, groups) : Json(nullptr);
   return j;
+}
+
+// The drives the map was merged from, in order: each one's name, its number of entries and its
+// trajectory (float32 xyz; null when it has none, as the first, which defines the map's frame).
+// The map of one run is one session, "this run".
+Json sessionsJson(const TargetMap& map, const Eigen::Vector3d& origin) {
+  Json out = Json::array();
+  if (map.sessions.empty()) {
+    out.push_back({{"name", "this run"}, {"entries", map.size()}, {"trajectory", nullptr}});
+    return out;
+  }
+  std::vector<size_t> entries(map.sessions.size(), 0);
+  for (size_t i = 0; i < map.segments.size(); ++i) {
+    const size_t session = map.segments[i].session;
+    if (session >= entries.size())
+      throw std::runtime_error((map.source.empty() ? std::string("the map") : map.source) +
+                               ": segment " + std::to_string(i) + " is of session " +
+                               std::to_string(session) + ", but the map has " +
+                               std::to_string(entries.size()) + " sessions");
+    ++entries[session];
+  }
+  for (size_t k = 0; k < map.sessions.size(); ++k) {
+    std::vector<float> trajectory;
+    for (const Pose& T_map_base : map.sessions[k].trajectory)
+      appendXyz(trajectory, T_map_base.translation(), origin);
+    out.push_back({{"name", map.sessions[k].name},
+                   {"entries", entries[k]},
+                   {"trajectory", trajectory.empty() ? Json(nullptr) : Json(base64(trajectory))}});
+  }
+  return out;
 }
 
 // The robot's position in the map at every trajectory row from the first localization on: its
@@ -274,7 +309,8 @@ nlohmann::ordered_json sceneJson(const SceneInputs& in) {
             {"colouring", in.colouring},
             {"origin", {origin.x(), origin.y(), origin.z()}},
             {"classes", classesJson(in.classes)},
-            {"map", mapJson(in, origin)}};
+            {"map", mapJson(in, origin)},
+            {"sessions", sessionsJson(*in.map, origin)}};
   j["localization"] = in.localization ? localizationJson(*in.localization, origin) : Json(nullptr);
   j["slam"] = in.slam ? slamJson(*in.slam, origin) : Json(nullptr);
   j["segments"] = in.segments ? segmentsJson(*in.segments, origin, in.classes) : Json(nullptr);
