@@ -527,6 +527,40 @@ def registration_table(inputs):
                    ("frame-to-frame error", 0), ("meets 20 Hz?", 0)], rows) + machine_line(inputs))
 
 
+def fleet_table(inputs):
+    """The sessions of `eval fleet` merged into one map, and the fifth run against it."""
+    if len(inputs) != 1:
+        fail("the fleet table takes one fleet.json")
+    e = load_json(inputs[0], "sessions", "a fleet.json of semsegmap eval fleet")
+    header = [("session", 0), ("frames", 1), ("aligned", 0), ("localizations", 1),
+              ("entries", 1), ("of segments the map held", 1), ("tie residual", 1),
+              ("trajectory error", 1), ("centroid error", 1)]
+    rows = []
+    for i, r in enumerate(e["sessions"]):
+        aligned = "map frame" if i == 0 else ("yes" if r["aligned"] else "no")
+        rows.append([r["run"], r["frames"], aligned, r["localizations"], r["entries"],
+                     r["same_segments"], f"{r['tie_residual_m']:.2f} m",
+                     f"{r['trajectory_error_m']:.2f} m", f"{r['centroid_error_m']:.2f} m"])
+    out = table(header, rows)
+    out += (f"\nMerged map: {e['entries']} entries of {e['segments']} segments; centroids "
+            f"{e['centroid_mean_m']:.2f} m from the truth on average (median "
+            f"{e['centroid_median_m']:.2f} m) after one rigid alignment to the world.\n")
+    if e.get("interrupted"):
+        out += "\nThe run was interrupted: these numbers are partial.\n"
+    if not e.get("queries"):
+        return out
+    first = e["sessions"][0]["run"]
+    header = [("run", 0), ("frames", 1), ("against", 0), ("localizations", 1),
+              ("within 1 m", 1), ("wrong (> 5 m)", 1)]
+    rows = []
+    for q in e["queries"]:
+        for key, against in (("merged", "the merged map"), ("first", f"{first} alone")):
+            r = q[key]
+            rows.append([q["run"], q["frames"], against, r["localizations"], r["within_1m"],
+                         r["wrong"]])
+    return out + "\n" + table(header, rows)
+
+
 TABLES = {"rigs": rigs_table, "runs": runs_table, "table-i": table_i, "configs": configs_table,
           "label-noise": label_noise_table, "label-rate": label_rate_table,
           "segmentation": segmentation_table,
@@ -534,7 +568,7 @@ TABLES = {"rigs": rigs_table, "runs": runs_table, "table-i": table_i, "configs":
           "memory": memory_table, "slam": slam_table,
           "segments": segments_table, "odometry": odometry_table,
           "revisits": revisits_table, "wake-ups": wake_ups_table,
-          "registration": registration_table}
+          "registration": registration_table, "fleet": fleet_table}
 
 
 def replace_section(text, section, new_table, doc):

@@ -8,6 +8,7 @@
 #include "build_options.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/json.h"
+#include "semsegmap/eval/fleet_experiment.h"
 #include "semsegmap/eval/localization_metrics.h"
 #include "semsegmap/eval/report.h"
 #include "semsegmap/settings/config.h"
@@ -239,6 +240,38 @@ TEST(LocalizationExperiment, PassesOnTheSameFramesGiveWhatEachGivesAlone) {
   evaluateLocalization(c, tmp.path() / "classes");
   EXPECT_NE(readFileBytes(tmp.path() / "classes/maps/semsegmap.map"),
             readFileBytes(tmp.path() / "network/maps/semsegmap.map"));
+}
+
+// [fleet]: two drives of one route on their own LiDAR odometry, the second joined to the first's
+// map; the merged map's entries where the truth puts them (after one rigid alignment, since the
+// map's frame is the first drive's odometry frame), and a third drive localized against both
+// maps, counted in the world.
+TEST(FleetExperiment, TwoDrivesMergeWhereTheTruthIsAndAThirdLocalizesInTheWorld) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  SEMSEGMAP_SKIP_WITHOUT_TORCH();
+  FleetExperimentConfig c;
+  c.preset = "tiny";
+  c.max_frames = 100;
+  c.sessions = {"S0", "S0,traffic=7"};
+  c.queries = {"S0,traffic=3"};
+  c.config = std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap.yaml";
+  const FleetExperiment e = runFleetExperiment(c);
+  ASSERT_EQ(e.sessions.size(), 2u);
+  EXPECT_TRUE(e.sessions[1].aligned);
+  EXPECT_GE(e.sessions[1].ties, 3u);
+  EXPECT_GT(e.sessions[1].same_segments, e.sessions[1].entries / 3);
+  EXPECT_EQ(e.entries, e.sessions[0].entries + e.sessions[1].entries);
+  EXPECT_LT(e.segments, e.entries);
+  EXPECT_LT(e.centroid_mean_m, 0.5);
+  EXPECT_LT(e.sessions[1].trajectory_error_m, 0.5);
+  ASSERT_EQ(e.queries.size(), 1u);
+  const FleetQuery& q = e.queries[0];
+  EXPECT_GT(q.within_1m_merged, q.localizations_merged / 2);
+  EXPECT_EQ(q.wrong_merged, 0u);
+  EXPECT_GE(q.within_1m_merged + 2, q.within_1m_first);
+  const auto j = toJson(e);
+  EXPECT_EQ(j["sessions"].size(), 2u);
+  EXPECT_NE(fleetTable(e).find("| S0,traffic=7 |"), std::string::npos);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/describe/descriptor.h"
+#include "semsegmap/eval/fleet_experiment.h"
 #include "semsegmap/eval/report.h"
 #include "semsegmap/settings/config.h"
 
@@ -183,6 +184,27 @@ int runEvalLocalization(const CliArgs& a) {
   return experimentEnd(a, e.interrupted, progress);
 }
 
+// [fleet]: the runs as sessions on LiDAR odometry, joined into one map, judged against the truth.
+int runEvalFleet(const CliArgs& a) {
+  const std::filesystem::path out = a.get("out");
+  FleetExperimentConfig c;
+  c.world_seed = a.getCount("world-seed");
+  c.preset = a.get("preset");
+  c.max_frames = a.frameLimit();
+  c.config = a.getPath("config");
+  c.sessions = splitList(a.get("sessions"));
+  c.queries = {a.get("fifth-run")};
+  c.stop = stopToken();
+  StageProgress progress;
+  c.progress = std::ref(progress);
+  const FleetExperiment e = runFleetExperiment(c);
+  if (e.interrupted && !progress.started()) return experimentEnd(a, true, progress);
+  writeFleetExperiment(e, out);
+  std::cout << fleetTable(e) << "wrote " << (out / "fleet.json").string()
+            << ", fleet.md, fleet.map\n";
+  return experimentEnd(a, e.interrupted, progress);
+}
+
 // The three experiments in turn; after Ctrl-C no further one starts, and report.md shows those
 // that ran, saying it is partial.
 int runEvalPaper(const CliArgs& a) {
@@ -287,6 +309,23 @@ const std::vector<const CommandSpec*>& simulatedEvalCommands() {
       "",
       runEvalLocalization,
       /*stops_between_frames=*/true};
+  static const CommandSpec fleet{
+      "eval fleet",
+      "the runs as sessions on LiDAR odometry merged into one map, against the truth -> "
+      "fleet.json",
+      {kWorldSeed,
+       kOut,
+       {"preset", Value::kText, "full|small|tiny", "small", "size of the world"},
+       kMaxFrames,
+       {"config", Value::kText, "FILE", "config/semsegmap.yaml",
+        "the pipeline configuration (default: shipped)"},
+       {"sessions", Value::kText, "LIST", "S0,S1,S2,S3",
+        "the runs joined in turn, the first the map's frame"},
+       {"fifth-run", Value::kText, "RUN[,KEYS]", "S0,traffic=7",
+        "the run localized against the merged map and the first session's alone"}},
+      "",
+      runEvalFleet,
+      /*stops_between_frames=*/true};
   static const CommandSpec paper{
       "eval paper",
       "the segmentation, descriptor and localization experiments, and report.md",
@@ -296,7 +335,7 @@ const std::vector<const CommandSpec*>& simulatedEvalCommands() {
       runEvalPaper,
       /*stops_between_frames=*/true};
   static const std::vector<const CommandSpec*> all = {&segmentation, &descriptors, &localization,
-                                                      &paper};
+                                                      &fleet, &paper};
   return all;
 }
 

@@ -278,6 +278,27 @@ def documented_writes():
     return calls
 
 
+def test_fleet_table_shows_each_session_and_the_fifth_run_against_both_maps(tmp_path):
+    session = {"aligned": True, "frames": 10, "localizations": 4, "entries": 30,
+               "same_segments": 12, "tie_residual_m": 0.25, "trajectory_error_m": 0.31,
+               "centroid_error_m": 0.4}
+    fleet = {"sessions": [dict(session, run="S0", localizations=0),
+                          dict(session, run="S1"), dict(session, run="S2", aligned=False)],
+             "entries": 60, "segments": 48, "centroid_mean_m": 0.123, "centroid_median_m": 0.1,
+             "queries": [{"run": "S0,traffic=7", "frames": 50,
+                          "merged": {"localizations": 20, "within_1m": 18, "wrong": 0},
+                          "first": {"localizations": 19, "within_1m": 15, "wrong": 1}}]}
+    path = tmp_path / "fleet.json"
+    path.write_text(json.dumps(fleet))
+    lines = write_table(tmp_path, "fleet", [str(path)])
+    assert lines[2].startswith("| S0 | 10 | map frame | 0 | 30 | 12 | 0.25 m | 0.31 m |")
+    assert lines[4].startswith("| S2 | 10 | no |")
+    text = (tmp_path / "doc.md").read_text()
+    assert "centroids 0.12 m from the truth on average (median 0.10 m)" in text
+    assert "| S0,traffic=7 | 50 | the merged map | 20 | 18 | 0 |" in lines
+    assert "| S0,traffic=7 | 50 | S0 alone | 19 | 15 | 1 |" in lines
+
+
 def test_every_results_section_is_written_by_a_documented_command():
     """docs/*.md and the README: each section is written by a write_results.py call of docs/
     with a table kind the script has, and each call names a section of its document, so that
