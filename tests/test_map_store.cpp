@@ -19,6 +19,7 @@
 #include "semsegmap/store/map_location.h"
 #include "semsegmap/store/map_store_uri.h"
 #include "semsegmap/store/pg_map_store.h"
+#include "semsegmap/store/store_tiles.h"
 #include "temp_dir.h"
 
 namespace semsegmap {
@@ -187,6 +188,33 @@ TEST(MapStore, ARegionLoadsTheEntriesWithinItsRadiusAndTheirSessions) {
   const TargetMap whole = loadMapAt(cluster().uri("region"));
   EXPECT_EQ(whole.size(), 400u);
   EXPECT_EQ(whole.sessions.size(), 2u);
+}
+
+// Tiles: each entry once, an entry on a shared edge in one tile only, and only new tiles as the
+// robot moves.
+TEST(MapStore, TilesHandOutEachEntryOnceAsTheRobotMoves) {
+  SEMSEGMAP_NEED_SERVER();
+  saveMapAt(cluster().uri("tiles"), gridMap(400, {-100, -100}, 10.0f, 9), {}, "drive");
+  StoreTiles tiles(parseMapStoreUri(cluster().uri("tiles")), {-60, -60}, 30.0, 20.0);
+  const TargetMap first = tiles.around(-60, -60);
+  EXPECT_EQ(tiles.centre(), Eigen::Vector2d(-60, -60));
+  EXPECT_GT(first.size(), 0u);
+  EXPECT_EQ(first.descriptor, "eigen");  // the header comes with every load
+  for (const MapSegment& s : first.segments) {
+    EXPECT_GE(s.centroid.x(), -100.0f);
+    EXPECT_LT(s.centroid.x(), -20.0f);  // the tiles touching the disc: [-100, -20)
+  }
+  EXPECT_EQ(tiles.around(-60, -60).size(), 0u);  // nothing twice
+  std::set<uint32_t> seen;
+  for (const MapSegment& s : first.segments) EXPECT_TRUE(seen.insert(s.segment).second);
+  size_t total = first.size();
+  for (double x = -40; x <= 100; x += 20)
+    for (const MapSegment& s : tiles.around(x, -60).segments) {
+      EXPECT_TRUE(seen.insert(s.segment).second) << "segment " << s.segment << " twice";
+      ++total;
+    }
+  // Row y in [-100, -20) of the grid, all x: 8 rows of 20.
+  EXPECT_EQ(total, 160u);
 }
 
 TEST(MapStore, ErrorsAreOneLineNamingTheStore) {
@@ -484,10 +512,16 @@ TEST(MapStoreCli, MapsJoinsLocalizesListsExportsImportsAndDrops) {
   ASSERT_EQ(show.code, 0) << show.err;
   EXPECT_NE(show.out.find("traffic=7"), std::string::npos) << show.out;
 
+  // Localized in tiles from a region around the map's middle (store_tiles.h).
+  Eigen::Vector3f middle = Eigen::Vector3f::Zero();
+  const TargetMap town = store.load("town");
+  for (const MapSegment& s : town.segments) middle += s.centroid / static_cast<float>(town.size());
   const auto localize =
-      runCli("localize --dataset sim:world=1,run=S1,preset=tiny,frames=40" + config + " --map " +
-             uri + " --out " + (tmp.path() / "loc").string());
+      runCli("localize --dataset sim:world=1,run=S1,preset=tiny,frames=40" + config + " --map '" +
+             cluster().uri("town") + "&region=" + std::to_string(middle.x()) + "," +
+             std::to_string(middle.y()) + ",150' --out " + (tmp.path() / "loc").string());
   ASSERT_EQ(localize.code, 0) << localize.err;
+  EXPECT_NE(localize.err.find("map tiles: "), std::string::npos) << localize.err;
   EXPECT_TRUE(std::filesystem::exists(tmp.path() / "loc" / "localizations.csv"));
 
   // The viewer on a region of the store, each session in its colour (a build with the viewer).

@@ -14,6 +14,7 @@
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/datasets/open_dataset.h"
+#include "semsegmap/pipeline/map_tiles.h"
 #include "semsegmap/pipeline/session_merge.h"
 #include "semsegmap/settings/config.h"
 
@@ -192,6 +193,78 @@ TEST(SessionMerge, AMapOfOtherSettingsIsRefusedNamingIt) {
     EXPECT_NE(std::string(e.what()).find("A.map: segmentation.d_segment_m"), std::string::npos)
         << e.what();
   }
+}
+
+// A map served in tiles from memory, as a store serves it (store/store_tiles.h): the entries of
+// the square tiles that touch the disc around the robot, each tile once.
+class MemoryTiles : public MapTileSource {
+ public:
+  MemoryTiles(std::shared_ptr<const TargetMap> map, Eigen::Vector2d centre, double radius_m)
+      : map_(std::move(map)), centre_(centre), radius_m_(radius_m) {}
+  TargetMap around(double x, double y) override {
+    centre_ = {x, y};
+    ++calls_;
+    TargetMap out = *map_;
+    out.segments.clear();
+    std::vector<Eigen::Index> rows;
+    for (size_t i = 0; i < map_->size(); ++i) {
+      const Eigen::Vector3f& c = map_->segments[i].centroid;
+      const std::pair<long, long> tile{std::lround(std::floor(c.x() / kTile)),
+                                       std::lround(std::floor(c.y() / kTile))};
+      const double dx = std::max({tile.first * kTile - x, 0.0, x - (tile.first + 1) * kTile});
+      const double dy = std::max({tile.second * kTile - y, 0.0, y - (tile.second + 1) * kTile});
+      if (dx * dx + dy * dy > radius_m_ * radius_m_ || given_.count(i)) continue;
+      given_.insert(i);
+      out.segments.push_back(map_->segments[i]);
+      rows.push_back(static_cast<Eigen::Index>(i));
+    }
+    out.descriptors.resize(static_cast<Eigen::Index>(rows.size()), map_->dimension());
+    for (size_t k = 0; k < rows.size(); ++k)
+      out.descriptors.row(static_cast<Eigen::Index>(k)) = map_->descriptors.row(rows[k]);
+    return out;
+  }
+  Eigen::Vector2d centre() const override { return centre_; }
+  double reloadAfterM() const override { return kTile / 2; }
+  size_t calls() const { return calls_; }
+  size_t given() const { return given_.size(); }
+
+ private:
+  static constexpr double kTile = 40.0;
+  std::shared_ptr<const TargetMap> map_;
+  Eigen::Vector2d centre_;
+  double radius_m_;
+  size_t calls_ = 0;
+  std::set<size_t> given_;
+};
+
+// A robot that starts with the tiles around its start alone finds itself further on, in tiles
+// asked for as it moves, as often as with the whole map.
+TEST(MapTiles, ALocalizationFollowsTheTilesAheadAsTheRobotMoves) {
+  SEMSEGMAP_SKIP_WITHOUT_SIM();
+  const auto map = mapOf("sim:world=1,run=S0,preset=tiny,frames=150");
+  const std::string spec = "sim:world=1,run=S0,preset=tiny,frames=150,traffic=7";
+  auto describer = std::make_shared<OracleDescriber>();
+  auto whole_source = openDataset(spec);
+  const LocalizationRun whole = runLocalization(*whole_source, config(), map, describer);
+  const Eigen::Vector2d start = whole.trajectory_gt.front().translation().head<2>();
+  auto tiles = std::make_shared<MemoryTiles>(map, start, 50.0);
+  const auto first = std::make_shared<const TargetMap>(tiles->around(start.x(), start.y()));
+  ASSERT_LT(first->size(), map->size() * 2 / 3) << "the first tiles must not hold the map";
+  auto source = openDataset(spec);
+  const LocalizationRun tiled = runLocalization(*source, config(), first, describer, {},
+                                                MapSettingsCheck::kRefuse, std::nullopt, tiles);
+  EXPECT_GT(tiles->calls(), 2u);
+  EXPECT_GT(tiles->given(), first->size());
+  size_t within = 0, far_within = 0, whole_within = 0;
+  for (const LocalizationRecord& r : tiled.localizations) {
+    within += r.translation_error_m < 1.0;
+    far_within += r.translation_error_m < 1.0 &&
+                  (r.T_world_base->translation().head<2>() - start).norm() > 80.0;
+  }
+  for (const LocalizationRecord& r : whole.localizations)
+    whole_within += r.translation_error_m < 1.0;
+  EXPECT_GT(far_within, 0u) << "no localization beyond the first tiles";
+  EXPECT_GE(within * 10, whole_within * 9) << within << " against " << whole_within;
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/diagnostics.h"
 #include "semsegmap/eval/localization_picture.h"
 #include "semsegmap/outputs/localization_details.h"
 #include "semsegmap/outputs/run_output.h"
@@ -25,6 +26,7 @@
 #include "semsegmap/settings/config.h"
 #include "semsegmap/store/map_location.h"
 #include "semsegmap/store/map_store_uri.h"
+#include "semsegmap/store/store_tiles.h"
 
 namespace semsegmap::app {
 
@@ -76,6 +78,21 @@ void writeLocalizeFiles(const CliArgs& a, const LocalizationRun& run, const Targ
                         const std::string& dataset);
 void printWritten(const CliArgs& a);
 
+// The tiles of a store map whose URI has region=X,Y,RADIUS (docs/map-store.md), centred there;
+// nothing for a file or a whole store map.
+std::shared_ptr<StoreTiles> storeTiles(const std::string& where) {
+  if (!isMapStoreUri(where)) return nullptr;
+  requireMapStoreBuilt(where);
+  const MapStoreUri uri = parseMapStoreUri(where);
+  if (!uri.region) return nullptr;
+#if SEMSEGMAP_WITH_POSTGRES
+  return std::make_shared<StoreTiles>(uri, Eigen::Vector2d(uri.region->x, uri.region->y),
+                                      uri.region->radius_m);
+#else
+  return nullptr;
+#endif
+}
+
 int runLocalize(const CliArgs& a) {
   if (a.has("follow") && a.get("dataset").rfind("folder:", 0) != 0)
     throw UsageError("--follow follows a folder a driver writes into: give --dataset folder:DIR");
@@ -89,7 +106,11 @@ int runLocalize(const CliArgs& a) {
   const std::optional<RelocalizationPrior> prior = priorOf(a, config);
   const std::filesystem::path map_path = a.get("map");
   const std::filesystem::path out = a.get("out");
-  const auto map = std::make_shared<const TargetMap>(loadMapAt(map_path.string()));
+  // A store map with region=: its tiles around the region, more as the robot moves.
+  std::shared_ptr<StoreTiles> tiles = storeTiles(map_path.string());
+  const auto map = std::make_shared<const TargetMap>(
+      tiles ? tiles->around(tiles->centre().x(), tiles->centre().y())
+            : loadMapAt(map_path.string()));
   // The map's recorded build settings against the configuration's, before the data is opened;
   // with --allow-config-mismatch the session warns of each difference instead.
   const MapSettingsCheck settings =
@@ -125,7 +146,8 @@ int runLocalize(const CliArgs& a) {
   options.stop = stopToken();
   options.stages = data.stages;
   const LocalizationRun run =
-      runLocalization(*source, config, map, describer, options, settings, prior);
+      runLocalization(*source, config, map, describer, options, settings, prior, tiles);
+  if (tiles) note("map tiles: " + std::to_string(tiles->tilesLoaded()) + " loaded along the drive");
   // Stopped before its first frame: nothing worth writing (main removes what the run made).
   if (run.stats.interrupted && run.stats.frames == 0)
     return interruptedRun("localize", 0, options.frameCount(*source), out.string());

@@ -4,6 +4,7 @@
 
 #include "bindings.h"
 #include "semsegmap/artefacts/map_file.h"
+#include "semsegmap/store/map_location.h"
 #include "semsegmap/describe/descriptor.h"
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/target_map.h"
@@ -180,17 +181,22 @@ void bindLocalize(py::module_& m) {
         MapWriteOptions options;
         options.float16 = float16;
         py::gil_scoped_release release;
-        return saveTargetMap(path, map, options);
+        return saveMapAt(path.string(), map, options, "python");
       },
       py::arg("path"), py::arg("map"), py::arg("float16") = true,
-      "Writes a target map (docs/map-format.md); returns its size in bytes");
+      "Writes a target map (docs/map-format.md), or a new map into a PostgreSQL store for a "
+      "postgresql://...?map=NAME URI (docs/map-store.md); returns the file's size in bytes (0 "
+      "for a store)");
   m.def(
       "load_map",
       [](const std::filesystem::path& path) {
         py::gil_scoped_release release;
-        return std::make_shared<TargetMap>(loadTargetMap(path));
+        return std::make_shared<TargetMap>(loadMapAt(path.string()));
       },
-      py::arg("path"), "RuntimeError '<path>: <what is wrong>' for a missing or corrupt file");
+      py::arg("path"),
+      "A map file, or a map of a PostgreSQL store (postgresql://...?map=NAME[&region=X,Y,R], "
+      "docs/map-store.md); RuntimeError '<path>: <what is wrong>' for a missing or corrupt file "
+      "or a store that cannot be read");
   m.def(
       "check_map_compatible",
       [](const TargetMap& map, const Describer& d, const std::string& name) {

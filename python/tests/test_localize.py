@@ -108,6 +108,19 @@ def test_map_file_errors_name_the_file(tmp_dir):
     assert one_line(e.value).startswith(corrupt + ": ")
 
 
+def test_a_map_path_may_be_a_store_uri():
+    # The store itself is tested against a real server by tests/test_map_store.cpp; here, that a
+    # postgresql:// path goes to it (a server that cannot be reached, in one line naming it).
+    uri = "postgresql://nohost.invalid/fleet?map=town&connect_timeout=5"
+    said = (uri + ": cannot connect", uri + ": this build has no PostgreSQL map store")
+    with pytest.raises(RuntimeError) as e:
+        ssm.load_map(uri)
+    assert one_line(e.value).startswith(said)
+    with pytest.raises(RuntimeError) as e:
+        ssm.save_map(uri, synthetic_map()[0])
+    assert one_line(e.value).startswith(said)
+
+
 def test_localization_recovers_a_known_pose():
     m, centroids, descriptors = synthetic_map()
     T_map_local = rigid(0.4, [5.0, -3.0, 0.2])

@@ -296,12 +296,24 @@ std::optional<LocalizationRecord> LocalizationSession::process(const Frame& fram
       run_.localizations.push_back(recordOf(frame, o));
       found = run_.localizations.back();
       localized_at_m_ = run_.distance_m;
+      T_map_local_ = o.T_map_base * r.T_local_base.inverse();
     }
   }
+  if (tiles_) followRobot(r.T_local_base);
   run_.stats.total += r.times;
   ++run_.stats.frames;
   if (!keep_history_) forgetHistory();
   return found;
+}
+
+// Where the robot is in the map (its last localization carried on by odometry): far enough from
+// where the tiles were last asked for, the tiles around it join the localizer.
+void LocalizationSession::followRobot(const Pose& T_local_base) {
+  if (!T_map_local_) return;
+  const Eigen::Vector2d at = (*T_map_local_ * T_local_base).translation().head<2>();
+  if ((at - tiles_->centre()).norm() < tiles_->reloadAfterM()) return;
+  const TargetMap more = tiles_->around(at.x(), at.y());
+  localizer_.append(more.segments, more.descriptors);
 }
 
 // The local map's segments first; then, when the scan lies far from the one before, its own
@@ -472,11 +484,12 @@ const char* localizationPathName(LocalizationPath path) {
 LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& config,
                                 std::shared_ptr<const TargetMap> map,
                                 std::shared_ptr<Describer> describer, const RunOptions& options,
-                                MapSettingsCheck settings,
-                                std::optional<RelocalizationPrior> prior) {
+                                MapSettingsCheck settings, std::optional<RelocalizationPrior> prior,
+                                std::shared_ptr<MapTileSource> tiles) {
   LocalizationSession session(config, source.info(), std::move(map), std::move(describer), settings,
                               options.stages);
   session.setPrior(std::move(prior));
+  session.followTiles(std::move(tiles));
   const bool whole = feed(source, options, session);
   LocalizationRun run = session.take();
   run.stats.interrupted = !whole;

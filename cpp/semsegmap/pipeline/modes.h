@@ -12,6 +12,7 @@
 
 #include "semsegmap/core/stop_token.h"
 #include "semsegmap/pipeline/map_parameters.h"
+#include "semsegmap/pipeline/map_tiles.h"
 #include "semsegmap/pipeline/pipeline.h"
 
 namespace semsegmap {
@@ -166,6 +167,11 @@ class LocalizationSession {
   // Where the robot is known to be (a GNSS fix, the last saved pose, a user's guess): a
   // relocalization then only searches the map within the prior's radius. Nothing: everywhere.
   void setPrior(std::optional<RelocalizationPrior> prior) { prior_ = std::move(prior); }
+  // A map served in tiles (map_tiles.h): the session's map holds those around tiles->centre();
+  // once the robot has localized, every tiles->reloadAfterM() metres it moves (by the pose in
+  // the map its last localization gave, carried on by odometry) the tiles around it are asked
+  // for and added to the localizer. Tiles are never dropped: a drive's map only grows.
+  void followTiles(std::shared_ptr<MapTileSource> tiles) { tiles_ = std::move(tiles); }
   const LocalizationRun& run() const { return run_; }
   LocalizationRun take() {
     run_.stats.labelling = pipeline_.labeling();
@@ -214,6 +220,9 @@ class LocalizationSession {
   FrontEndStages stages_;
   Localizer localizer_;
   Pipeline pipeline_;
+  std::shared_ptr<MapTileSource> tiles_;
+  std::optional<Pose> T_map_local_;  // from the last localization
+  void followRobot(const Pose& T_local_base);
   LocalizationRun run_;
   size_t frames_ = 0;
   bool keep_history_ = true;
@@ -226,7 +235,8 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
                                 std::shared_ptr<Describer> describer,
                                 const RunOptions& options = {},
                                 MapSettingsCheck settings = MapSettingsCheck::kRefuse,
-                                std::optional<RelocalizationPrior> prior = std::nullopt);
+                                std::optional<RelocalizationPrior> prior = std::nullopt,
+                                std::shared_ptr<MapTileSource> tiles = nullptr);
 
 struct LocalizationSummary {
   size_t localizations = 0;

@@ -460,22 +460,73 @@ void readScanContexts(PGconn* c, const std::string& shown, const std::string& wh
   }
 }
 
-std::string regionCondition(const char* column) {
-  return std::string("ST_DWithin(") + column + ", ST_SetSRID(ST_MakePoint($2, $3), 0), $4)";
+std::string number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
 }
 
-std::vector<std::string> regionParams(int map_id, const MapRegion& r) {
-  char buf[3][40];
-  std::snprintf(buf[0], sizeof buf[0], "%.17g", r.x);
-  std::snprintf(buf[1], sizeof buf[1], "%.17g", r.y);
-  std::snprintf(buf[2], sizeof buf[2], "%.17g", r.radius_m);
-  return {std::to_string(map_id), buf[0], buf[1], buf[2]};
+}  // namespace
+
+// Which entries and scan contexts a load reads: SQL conditions on the segment's centroid
+// (g.centroid) and the scan context's position, their parameters from $2 ($1 is the map's id).
+struct PgMapStore::Selection {
+  std::string segments = "true", scans = "true";
+  std::vector<std::string> params;
+  bool every_session = true;  // else only those with entries selected
+};
+
+namespace {
+
+PgMapStore::Selection regionSelection(const MapRegion& r) {
+  PgMapStore::Selection s;
+  const auto within = [](const char* column) {
+    return std::string("ST_DWithin(") + column + ", ST_SetSRID(ST_MakePoint($2, $3), 0), $4)";
+  };
+  s.segments = within("g.centroid");
+  s.scans = within("position");
+  s.params = {number(r.x), number(r.y), number(r.radius_m)};
+  s.every_session = false;
+  return s;
+}
+
+// Half-open boxes [x0, x1) x [y0, y1): an entry on a shared edge is in one tile only. The bounding
+// box test (&&) lets the spatial index find them.
+PgMapStore::Selection boxSelection(const std::vector<MapBox>& boxes) {
+  PgMapStore::Selection s;
+  s.every_session = false;
+  std::string segments, scans;
+  for (const MapBox& b : boxes) {
+    const auto n = [&](size_t k) { return "$" + std::to_string(2 + s.params.size() + k); };
+    const std::string x0 = n(0), y0 = n(1), x1 = n(2), y1 = n(3);
+    const auto in = [&](const std::string& c) {
+      return "(" + c + " && ST_MakeEnvelope(" + x0 + ", " + y0 + ", " + x1 + ", " + y1 +
+             ", 0) AND ST_X(" + c + ") >= " + x0 + " AND ST_X(" + c + ") < " + x1 + " AND ST_Y(" +
+             c + ") >= " + y0 + " AND ST_Y(" + c + ") < " + y1 + ")";
+    };
+    segments += (segments.empty() ? "" : " OR ") + in("g.centroid");
+    scans += (scans.empty() ? "" : " OR ") + in("position");
+    for (double v : {b.x0, b.y0, b.x1, b.y1}) s.params.push_back(number(v));
+  }
+  if (boxes.empty()) segments = scans = "false";
+  s.segments = "(" + segments + ")";
+  s.scans = "(" + scans + ")";
+  return s;
 }
 
 }  // namespace
 
 TargetMap PgMapStore::load(const std::string& name, const std::optional<MapRegion>& region,
                            MapSnapshot* snapshot) {
+  return loadSelected(name, region ? regionSelection(*region) : Selection{}, snapshot);
+}
+
+TargetMap PgMapStore::loadBoxes(const std::string& name, const std::vector<MapBox>& boxes) {
+  return loadSelected(name, boxSelection(boxes), nullptr);
+}
+
+TargetMap PgMapStore::loadSelected(const std::string& name, const Selection& selection,
+                                   MapSnapshot* snapshot) {
   const std::string doing = "loading map " + name;
   Transaction t(conn_, shown_, doing);
   run(conn_, shown_, doing, "SET TRANSACTION ISOLATION LEVEL REPEATABLE READ");
@@ -500,20 +551,20 @@ TargetMap PgMapStore::load(const std::string& name, const std::optional<MapRegio
                             {sid});
   for (int i = 0; i < params.rows(); ++i)
     map.parameters.emplace_back(params.text(i, 0), params.text(i, 1));
-  const std::string where = region ? regionCondition("g.centroid") : "true";
-  const std::vector<std::string> p = region ? regionParams(id, *region) : std::vector{sid};
+  std::vector<std::string> p = {sid};
+  p.insert(p.end(), selection.params.begin(), selection.params.end());
   // A region's sessions are those with entries in it: a store of thousands of drives would
   // otherwise send every trajectory with every tile.
-  const Result sessions = run(conn_, shown_, doing,
-                              "SELECT s.id, s.name, s.merged_unix_s, s.trajectory "
-                              "FROM semsegmap_sessions s WHERE s.map_id = $1 AND " +
-                                  std::string(region ? "s.id IN (SELECT g.session_id FROM "
-                                                       "semsegmap_segments g WHERE g.map_id = $1 "
-                                                       "AND " +
-                                                           where + ")"
-                                                     : "true") +
-                                  " ORDER BY s.id",
-                              p, /*binary=*/true);
+  const Result sessions =
+      run(conn_, shown_, doing,
+          "SELECT s.id, s.name, s.merged_unix_s, s.trajectory "
+          "FROM semsegmap_sessions s WHERE s.map_id = $1 AND " +
+              (selection.every_session ? std::string("true")
+                                       : "s.id IN (SELECT g.session_id FROM semsegmap_segments g "
+                                         "WHERE g.map_id = $1 AND " +
+                                             selection.segments + ")") +
+              " ORDER BY s.id",
+          p, /*binary=*/true);
   std::map<int64_t, uint16_t> position;
   for (int i = 0; i < sessions.rows(); ++i) {
     position[sessions.big<int64_t>(i, 0)] = static_cast<uint16_t>(i);
@@ -525,10 +576,8 @@ TargetMap PgMapStore::load(const std::string& name, const std::optional<MapRegio
     r.expectEnd("the trajectory");
     map.sessions.push_back(std::move(s));
   }
-  readSegments(conn_, shown_, where, p, position, map);
-  if (!head.null(0, 4))
-    readScanContexts(conn_, shown_, region ? regionCondition("position") : "true", p,
-                     head.bytes(0, 4), map);
+  readSegments(conn_, shown_, selection.segments, p, position, map);
+  if (!head.null(0, 4)) readScanContexts(conn_, shown_, selection.scans, p, head.bytes(0, 4), map);
   t.commit();
   if (const std::string bad = firstUnsavable(map); !bad.empty())
     throw std::runtime_error(shown_ + ": map '" + name + "': " + bad);

@@ -25,6 +25,11 @@ namespace semsegmap {
 // The store's schema version (semsegmap_schema); older stores are migrated in place on connect.
 int mapStoreSchemaVersion();
 
+// A box of the map frame, [x0, x1) x [y0, y1): a tile (store_tiles.h).
+struct MapBox {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
 struct StoredMap {
   std::string name, descriptor;
   int dimension = 0;
@@ -83,6 +88,8 @@ class PgMapStore {
   // map format version.
   TargetMap load(const std::string& name, const std::optional<MapRegion>& region = {},
                  MapSnapshot* snapshot = nullptr);
+  // The entries within `boxes` (each entry once, on a shared edge in one box) and their sessions.
+  TargetMap loadBoxes(const std::string& name, const std::vector<MapBox>& boxes);
   // A new map, in one transaction. A map without sessions becomes one session named
   // `session_name`. Throws when `name` exists.
   void create(const std::string& name, const TargetMap& map, const std::string& session_name);
@@ -96,7 +103,11 @@ class PgMapStore {
 
   const std::string& shown() const { return shown_; }
 
+  struct Selection;  // store/pg_map_store.cpp
+
  private:
+  TargetMap loadSelected(const std::string& name, const Selection& selection,
+                         MapSnapshot* snapshot);
   int mapId(const std::string& name, bool lock);
   PGconn* conn_ = nullptr;
   std::string shown_;
