@@ -3,7 +3,9 @@
 // As root (CI) the server runs as the unprivileged `postgres` user, which Debian's postgresql
 // package creates: PostgreSQL refuses to run as root. The binaries are those of Debian's
 // postgresql-15 (scripts/setup.sh); a machine without them fails the test, saying so. The
-// benchmark of the store (bench/) starts its server the same way.
+// benchmark of the store (bench/bench_map_store.cpp) starts its server the same way, with extra
+// server settings (`extra_options`: more `-c name=value`, after the defaults, so they override
+// them) and restarts it with others between its phases.
 #pragma once
 
 #include <pwd.h>
@@ -11,13 +13,15 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace semsegmap::test_support {
 
 class PgCluster {
  public:
-  PgCluster() {
+  // `extra_options`: server options appended to the defaults, e.g. "-c shared_buffers=1GB".
+  explicit PgCluster(std::string extra_options = "") {
     bin_ = findBin();
     if (bin_.empty()) return;
     char pattern[] = "/tmp/ssm-pg-XXXXXX";  // short: a socket path has at most 107 bytes
@@ -37,23 +41,32 @@ class PgCluster {
       error_ = "initdb failed (" + dir_ + "/initdb.log)";
       return;
     }
-    // fsync off: a test server loses nothing it must keep.
-    if (!sh(as_ + bin_ + "/pg_ctl -D " + data + " -l " + log + " -w -t 60 -o \"-k " + dir_ +
-            " -c listen_addresses='' -c fsync=off -c synchronous_commit=off "
-            "-c full_page_writes=off\" start > /dev/null 2>&1") ||
+    if (!start(extra_options) ||
         !sh(as_ + bin_ + "/createdb -h " + dir_ + " -U semsegmap semsegmap_test")) {
       error_ = "the server did not start (" + log + ")";
       return;
     }
-    started_ = true;
   }
-  ~PgCluster() {
+  ~PgCluster() { shutDown(); }
+  // Stops the server and removes its folder (unless SEMSEGMAP_KEEP_PG is set); again, nothing.
+  void shutDown() {
     if (started_)
       sh(as_ + bin_ + "/pg_ctl -D " + dir_ + "/data -m immediate -w stop > /dev/null 2>&1");
+    started_ = false;
     if (!dir_.empty() && !::getenv("SEMSEGMAP_KEEP_PG")) {
       std::error_code ignored;
       std::filesystem::remove_all(dir_, ignored);
     }
+  }
+  // Stops the server (cleanly: what was written stays), runs `while_stopped`, and starts it
+  // again with the defaults and `extra_options`; false when it does not come back.
+  bool restart(const std::string& extra_options, const std::function<void()>& while_stopped = {}) {
+    if (!started_) return false;
+    if (!sh(as_ + bin_ + "/pg_ctl -D " + dir_ + "/data -m fast -w -t 300 stop > /dev/null 2>&1"))
+      return false;
+    started_ = false;
+    if (while_stopped) while_stopped();
+    return start(extra_options);
   }
   PgCluster(const PgCluster&) = delete;
   PgCluster& operator=(const PgCluster&) = delete;
@@ -63,7 +76,8 @@ class PgCluster {
     if (bin_.empty())
       return "no PostgreSQL server binaries under /usr/lib/postgresql (scripts/setup.sh "
              "installs postgresql and postgresql-15-postgis-3)";
-    return started_ ? "" : error_;
+    if (!error_.empty()) return error_;
+    return started_ ? "" : "the server is not running (" + serverLog() + ")";
   }
   // The store's URI, with ?map=NAME when given.
   std::string uri(const std::string& map = "", const std::string& database = "semsegmap_test",
@@ -77,8 +91,19 @@ class PgCluster {
               " -c \"" + sql + "\" > /dev/null 2>&1");
   }
   const std::string& socketDir() const { return dir_; }
+  std::string dataDir() const { return dir_ + "/data"; }
+  std::string serverLog() const { return dir_ + "/server.log"; }
 
  private:
+  // fsync off: a test server loses nothing it must keep. Later `-c` settings override earlier.
+  bool start(const std::string& extra_options) {
+    started_ = sh(as_ + bin_ + "/pg_ctl -D " + dir_ + "/data -l " + dir_ + "/server.log" +
+                  " -w -t 60 -o \"-k " + dir_ +
+                  " -c listen_addresses='' -c fsync=off -c synchronous_commit=off "
+                  "-c full_page_writes=off " +
+                  extra_options + "\" start > /dev/null 2>&1");
+    return started_;
+  }
   static std::string findBin() {
     for (const char* v : {"17", "16", "15"}) {
       const std::string bin = std::string("/usr/lib/postgresql/") + v + "/bin";
