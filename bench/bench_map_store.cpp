@@ -556,8 +556,8 @@ const char* const kMeasureOptions =
     "-c shared_buffers=1GB -c maintenance_work_mem=1GB -c max_wal_size=4GB "
     "-c fsync=on -c full_page_writes=on -c synchronous_commit=on";
 
-int run(const Options& o) {
-  const auto started = Clock::now();
+// The run as the JSON's first lines: what was asked, and of what machine.
+json describeRun(const Options& o) {
   json out;
   out["schema"] = "semsegmap.store-bench/1";
   out["complete"] = false;
@@ -578,8 +578,19 @@ int run(const Options& o) {
       {"memory_gb",
        std::strtod(procField("/proc/meminfo", "MemTotal").c_str(), nullptr) / 1024.0 / 1024.0},
       {"load_average_at_start", loadAverage()}};
+  return out;
+}
 
-  const TargetMap source = loadInput("--source", o.source);
+// The maps the run reads: the source, tiled over the city, and another run's map for the
+// robot's queries when --queries gives one.
+struct Inputs {
+  TargetMap source;
+  std::optional<TargetMap> query_map;
+};
+
+Inputs loadInputs(const Options& o) {
+  Inputs in{loadInput("--source", o.source), std::nullopt};
+  const TargetMap& source = in.source;
   if (source.size() < o.insert_size)
     throw std::runtime_error("--source " + o.source + ": " + std::to_string(source.size()) +
                              " entries, fewer than --insert-size " + std::to_string(o.insert_size));
@@ -587,13 +598,16 @@ int run(const Options& o) {
     throw std::runtime_error("--segments " + std::to_string(o.segments) +
                              ": fewer than one tile (the source map has " +
                              std::to_string(source.size()) + " entries)");
-  std::optional<TargetMap> query_map;
   if (!o.queries.empty()) {
-    query_map = loadInput("--queries", o.queries);
-    checkMapCompatible("--queries " + o.queries, *query_map, source.descriptor, source.fingerprint,
-                       source.dimension());
+    in.query_map = loadInput("--queries", o.queries);
+    checkMapCompatible("--queries " + o.queries, *in.query_map, source.descriptor,
+                       source.fingerprint, source.dimension());
   }
-  const City city = layOut(source, o.segments, o.margin_m);
+  return in;
+}
+
+// The source and the city laid out from it, written before anything is built.
+void describeCity(const Options& o, const TargetMap& source, const City& city, json& out) {
   out["source"] = {
       {"entries", source.size()},
       {"descriptor", source.descriptor},
@@ -619,65 +633,70 @@ int run(const Options& o) {
                "%zu x %zu\n",
                city.segments, city.tiles, city.source_size, city.extent.x(), city.extent.y(),
                o.margin_m, city.columns, city.rows);
+}
 
-  PgCluster cluster(kBuildOptions);
-  if (!cluster.problem().empty())
-    throw std::runtime_error("the bench's PostgreSQL server: " + cluster.problem());
-  Watchdog watchdog(cluster);
-  const std::string uri = cluster.uri("city");
-  const std::string conninfo = parseMapStoreUri(cluster.uri(), false).conninfo;
-  {
-    Sql sql(conninfo);
-    out["server"] = {{"postgresql", sql.value("SHOW server_version")},
-                     {"build_options", kBuildOptions},
-                     {"measure_options", kMeasureOptions},
-                     {"test_defaults", "fsync=off synchronous_commit=off full_page_writes=off"}};
-  }
+json describeServer(const std::string& conninfo) {
+  Sql sql(conninfo);
+  return {{"postgresql", sql.value("SHOW server_version")},
+          {"build_options", kBuildOptions},
+          {"measure_options", kMeasureOptions},
+          {"test_defaults", "fsync=off synchronous_commit=off full_page_writes=off"}};
+}
 
-  // The build: the library's own writes, one transaction per tile.
+// A line at each whole percent of the tiles written (and at the last one), with the median of
+// the last 50 tiles: the build is most of a run at 10 million segments.
+void reportBuildProgress(const std::vector<double>& tile_ms, size_t tiles,
+                         Clock::time_point build_t0, size_t& reported) {
+  const size_t done = tile_ms.size();
+  if (done != tiles && done * 100 / tiles <= reported) return;
+  reported = done * 100 / tiles;
+  const double s_so_far = msSince(build_t0) / 1000.0;
+  const size_t from = done > 50 ? done - 50 : 0;
+  std::fprintf(
+      stderr, "build %3zu%%: %zu tiles, %.0f s, %.0f s left, last tiles %.0f ms\n", reported, done,
+      s_so_far, s_so_far / static_cast<double>(done) * static_cast<double>(tiles - done),
+      percentile(
+          std::vector<double>(tile_ms.begin() + static_cast<std::ptrdiff_t>(from), tile_ms.end()),
+          50));
+}
+
+// The build: the library's own writes, one transaction per tile. Each tile's time, in order.
+std::vector<double> writeTiles(const TargetMap& source, const City& city, const std::string& uri,
+                               const std::string& conninfo, Clock::time_point build_t0,
+                               json& server) {
   std::vector<double> tile_ms;
   tile_ms.reserve(city.tiles);
-  const auto build_t0 = Clock::now();
-  {
-    PgMapStore store(parseMapStoreUri(uri));
-    Sql sql(conninfo);
-    out["server"]["postgis"] = sql.value("SELECT postgis_lib_version()");
-    MapSnapshot snapshot;  // the newest session: nothing lands meanwhile
-    size_t reported = 0;
-    for (size_t t = 0; t < city.tiles; ++t) {
-      NewSession s =
-          tileSession(source, city.offset(t), city.entriesOf(t), "tile-" + std::to_string(t));
-      const auto t0 = Clock::now();
-      if (t == 0) {
-        TargetMap first;
-        first.descriptor = source.descriptor;
-        first.fingerprint = source.fingerprint;
-        first.parameters = source.parameters;
-        first.scan_contexts = ScanContextDatabase(source.scan_contexts.config());
-        first.sessions = {s.info};
-        first.segments = std::move(s.entries);
-        first.descriptors = std::move(s.descriptors);
-        store.create("city", first, s.info.name);
-        snapshot.last_session = store.sessions("city").back().id;
-      } else {
-        snapshot.last_session = store.addSession("city", s, snapshot, 1.5).session;
-      }
-      tile_ms.push_back(msSince(t0));
-      if (t + 1 == city.tiles || (t + 1) * 100 / city.tiles > reported) {
-        reported = (t + 1) * 100 / city.tiles;
-        const double s_so_far = msSince(build_t0) / 1000.0;
-        const size_t from = tile_ms.size() > 50 ? tile_ms.size() - 50 : 0;
-        std::fprintf(
-            stderr, "build %3zu%%: %zu tiles, %.0f s, %.0f s left, last tiles %.0f ms\n", reported,
-            t + 1, s_so_far,
-            s_so_far / static_cast<double>(t + 1) * static_cast<double>(city.tiles - t - 1),
-            percentile(std::vector<double>(tile_ms.begin() + static_cast<std::ptrdiff_t>(from),
-                                           tile_ms.end()),
-                       50));
-      }
+  PgMapStore store(parseMapStoreUri(uri));
+  Sql sql(conninfo);
+  server["postgis"] = sql.value("SELECT postgis_lib_version()");
+  MapSnapshot snapshot;  // the newest session: nothing lands meanwhile
+  size_t reported = 0;
+  for (size_t t = 0; t < city.tiles; ++t) {
+    NewSession s =
+        tileSession(source, city.offset(t), city.entriesOf(t), "tile-" + std::to_string(t));
+    const auto t0 = Clock::now();
+    if (t == 0) {
+      TargetMap first;
+      first.descriptor = source.descriptor;
+      first.fingerprint = source.fingerprint;
+      first.parameters = source.parameters;
+      first.scan_contexts = ScanContextDatabase(source.scan_contexts.config());
+      first.sessions = {s.info};
+      first.segments = std::move(s.entries);
+      first.descriptors = std::move(s.descriptors);
+      store.create("city", first, s.info.name);
+      snapshot.last_session = store.sessions("city").back().id;
+    } else {
+      snapshot.last_session = store.addSession("city", s, snapshot, 1.5).session;
     }
+    tile_ms.push_back(msSince(t0));
+    reportBuildProgress(tile_ms, city.tiles, build_t0, reported);
   }
-  const double build_s = msSince(build_t0) / 1000.0;
+  return tile_ms;
+}
+
+// The median tile time in each tenth of the build, in order.
+json medianByTenth(const std::vector<double>& tile_ms) {
   json deciles = json::array();
   for (size_t d = 0; d < 10; ++d) {
     const size_t a = tile_ms.size() * d / 10, b = tile_ms.size() * (d + 1) / 10;
@@ -687,227 +706,318 @@ int run(const Options& o) {
                                          tile_ms.begin() + static_cast<std::ptrdiff_t>(b)),
                      50));
   }
+  return deciles;
+}
+
+// The built store settled (VACUUM ANALYZE, CHECKPOINT) and measured, and its entries counted.
+void settleAndMeasure(const std::string& conninfo, const City& city, json& build) {
+  Sql sql(conninfo);
+  auto t0 = Clock::now();
+  sql.value("VACUUM ANALYZE");
+  build["vacuum_analyze_s"] = msSince(t0) / 1000.0;
+  t0 = Clock::now();
+  sql.value("CHECKPOINT");
+  build["checkpoint_s"] = msSince(t0) / 1000.0;
+  build["database_bytes"] = sql.integer("SELECT pg_database_size(current_database())");
+  build["segments_table_bytes"] = sql.integer("SELECT pg_table_size('semsegmap_segments')");
+  build["segments_index_bytes"] = sql.integer("SELECT pg_indexes_size('semsegmap_segments')");
+  build["centroid_index_bytes"] =
+      sql.integer("SELECT pg_relation_size('semsegmap_segments_centroid')");
+  const int64_t rows = sql.integer("SELECT count(*) FROM semsegmap_segments");
+  if (rows != static_cast<int64_t>(city.segments))
+    throw std::runtime_error("the store holds " + std::to_string(rows) + " entries, not " +
+                             std::to_string(city.segments));
+}
+
+void buildCity(const Options& o, const TargetMap& source, const City& city, const std::string& uri,
+               const std::string& conninfo, json& out) {
+  const auto build_t0 = Clock::now();
+  const std::vector<double> tile_ms =
+      writeTiles(source, city, uri, conninfo, build_t0, out["server"]);
+  const double build_s = msSince(build_t0) / 1000.0;
   out["build"] = {{"seconds", build_s},
                   {"path", "PgMapStore::create, then PgMapStore::addSession per tile"},
                   {"tile_ms", stats(tile_ms)},
-                  {"tile_ms_median_by_tenth", deciles}};
-  {
-    Sql sql(conninfo);
-    auto t0 = Clock::now();
-    sql.value("VACUUM ANALYZE");
-    out["build"]["vacuum_analyze_s"] = msSince(t0) / 1000.0;
-    t0 = Clock::now();
-    sql.value("CHECKPOINT");
-    out["build"]["checkpoint_s"] = msSince(t0) / 1000.0;
-    out["build"]["database_bytes"] = sql.integer("SELECT pg_database_size(current_database())");
-    out["build"]["segments_table_bytes"] =
-        sql.integer("SELECT pg_table_size('semsegmap_segments')");
-    out["build"]["segments_index_bytes"] =
-        sql.integer("SELECT pg_indexes_size('semsegmap_segments')");
-    out["build"]["centroid_index_bytes"] =
-        sql.integer("SELECT pg_relation_size('semsegmap_segments_centroid')");
-    const int64_t rows = sql.integer("SELECT count(*) FROM semsegmap_segments");
-    if (rows != static_cast<int64_t>(city.segments))
-      throw std::runtime_error("the store holds " + std::to_string(rows) + " entries, not " +
-                               std::to_string(city.segments));
-  }
+                  {"tile_ms_median_by_tenth", medianByTenth(tile_ms)}};
+  settleAndMeasure(conninfo, city, out["build"]);
   writeJson(o.json, out);
   std::fprintf(stderr, "built in %.0f s; %.2f GB\n", build_s,
                out["build"]["database_bytes"].get<double>() / 1e9);
+}
 
-  // Cold: the server restarted durable, its files out of the page cache.
+// Cold: the server restarted durable, its files out of the page cache. The store's connection
+// is made here, timed on its own: the loads after it are timed without it.
+std::unique_ptr<PgMapStore> restartCold(PgCluster& cluster, const std::string& uri,
+                                        json& region_load) {
   size_t evicted = 0;
   if (!cluster.restart(kMeasureOptions, [&] { evicted = evictFromPageCache(cluster.dataDir()); }))
     throw std::runtime_error("the bench's server did not restart (" + cluster.serverLog() + ")");
-  out["region_load"]["evicted_bytes"] = evicted;
-  auto t0 = Clock::now();
+  region_load["evicted_bytes"] = evicted;
+  const auto t0 = Clock::now();
   auto store = std::make_unique<PgMapStore>(parseMapStoreUri(uri));
-  out["region_load"]["connect_ms"] = msSince(t0);
+  region_load["connect_ms"] = msSince(t0);
+  return store;
+}
 
-  std::mt19937_64 rng(o.seed);
+// `count` places uniform over the city's full tiles.
+std::vector<Eigen::Vector2d> randomPlaces(const City& city, size_t count, std::mt19937_64& rng) {
   std::uniform_int_distribution<size_t> any_tile(0, city.full_tiles - 1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<Eigen::Vector2d> places;
-  for (size_t i = 0; i < o.loads; ++i) {
+  for (size_t i = 0; i < count; ++i) {
     const Eigen::Vector3d cell =
         city.offset(any_tile(rng)) + Eigen::Vector3d(city.min.x(), city.min.y(), 0);
     places.emplace_back(cell.x() + unit(rng) * city.pitch.x(),
                         cell.y() + unit(rng) * city.pitch.y());
   }
-  auto loadAll = [&](PgMapStore& from, double radius, std::vector<double>& entries,
-                     std::vector<double>& sessions) {
-    std::vector<double> ms;
-    for (const Eigen::Vector2d& p : places) {
-      const auto l0 = Clock::now();
-      const TargetMap m = from.load("city", MapRegion{p.x(), p.y(), radius});
-      ms.push_back(msSince(l0));
-      entries.push_back(static_cast<double>(m.size()));
-      sessions.push_back(static_cast<double>(m.sessions.size()));
+  return places;
+}
+
+// The region of `radius` around each place loaded once: each load's time; each region's entries
+// and sessions go to `entries` and `sessions`.
+std::vector<double> loadRegions(PgMapStore& from, const std::vector<Eigen::Vector2d>& places,
+                                double radius, std::vector<double>& entries,
+                                std::vector<double>& sessions) {
+  std::vector<double> ms;
+  for (const Eigen::Vector2d& p : places) {
+    const auto l0 = Clock::now();
+    const TargetMap m = from.load("city", MapRegion{p.x(), p.y(), radius});
+    ms.push_back(msSince(l0));
+    entries.push_back(static_cast<double>(m.size()));
+    sessions.push_back(static_cast<double>(m.sessions.size()));
+  }
+  return ms;
+}
+
+// The same places, warm (a second pass), at the radius and at larger discs: the one
+// circumscribing the 200 m square (a superset of the square's entries) and three times the
+// radius (the docs' example); each also through a connection with PostgreSQL's parallel query
+// off (a libpq option in the URI): a plan with a parallel worker pays for starting it.
+json loadsByRadius(PgMapStore& store, const std::string& uri,
+                   const std::vector<Eigen::Vector2d>& places, double radius_m,
+                   const std::vector<double>& warm, const std::vector<double>& entries) {
+  PgMapStore serial(parseMapStoreUri(uri + "&options=-c%20max_parallel_workers_per_gather%3D0"));
+  std::vector<double> unused_e, unused_s;
+  json radii = json::array();
+  for (const double radius : {radius_m, radius_m * std::sqrt(2.0), 3.0 * radius_m}) {
+    std::vector<double> ms = warm, e = entries, s;
+    if (radius != radius_m) {
+      loadRegions(store, places, radius, unused_e, unused_s);  // the first pass: partly cold
+      e.clear();
+      ms = loadRegions(store, places, radius, e, s);
     }
-    return ms;
-  };
+    const std::vector<double> serial_ms = loadRegions(serial, places, radius, unused_e, unused_s);
+    radii.push_back({{"radius_m", radius},
+                     {"warm_ms", stats(ms)},
+                     {"warm_ms_without_parallel_query", stats(serial_ms)},
+                     {"entries", stats(e)}});
+  }
+  return radii;
+}
+
+void measureRegionLoads(const Options& o, PgMapStore& store, const std::string& uri,
+                        const std::vector<Eigen::Vector2d>& places, json& out) {
   std::vector<double> entries, sessions, unused_e, unused_s;
-  const std::vector<double> cold = loadAll(*store, o.radius_m, entries, sessions);
-  const std::vector<double> warm = loadAll(*store, o.radius_m, unused_e, unused_s);
+  const std::vector<double> cold = loadRegions(store, places, o.radius_m, entries, sessions);
+  const std::vector<double> warm = loadRegions(store, places, o.radius_m, unused_e, unused_s);
   out["region_load"].update({{"radius_m", o.radius_m},
                              {"places", places.size()},
                              {"cold_ms", stats(cold)},
                              {"warm_ms", stats(warm)},
                              {"entries", stats(entries)},
                              {"sessions", stats(sessions)}});
-  // The same places, warm (a second pass), at the radius and at larger discs: the one
-  // circumscribing the 200 m square (a superset of the square's entries) and three times the
-  // radius (the docs' example); each also through a connection with PostgreSQL's parallel query
-  // off (a libpq option in the URI): a plan with a parallel worker pays for starting it.
-  PgMapStore serial(parseMapStoreUri(uri + "&options=-c%20max_parallel_workers_per_gather%3D0"));
-  json radii = json::array();
-  for (const double radius : {o.radius_m, o.radius_m * std::sqrt(2.0), 3.0 * o.radius_m}) {
-    std::vector<double> ms = warm, e = entries, s;
-    if (radius != o.radius_m) {
-      loadAll(*store, radius, unused_e, unused_s);  // the first pass: partly cold
-      e.clear();
-      ms = loadAll(*store, radius, e, s);
-    }
-    const std::vector<double> serial_ms = loadAll(serial, radius, unused_e, unused_s);
-    radii.push_back({{"radius_m", radius},
-                     {"warm_ms", stats(ms)},
-                     {"warm_ms_without_parallel_query", stats(serial_ms)},
-                     {"entries", stats(e)}});
-  }
-  out["region_load"]["radii"] = radii;
+  out["region_load"]["radii"] = loadsByRadius(store, uri, places, o.radius_m, warm, entries);
   writeJson(o.json, out);
   std::fprintf(stderr,
                "region load (%.0f m): cold median %.1f ms, warm median %.1f ms, %.0f entries\n",
                o.radius_m, percentile(cold, 50), percentile(warm, 50), percentile(entries, 50));
+}
 
-  // Inserts: new sessions at new places (the grid's next cells), then dropped again.
-  {
-    Sql sql(conninfo);
-    MapSnapshot snapshot;
-    snapshot.last_session = sql.integer("SELECT max(id) FROM semsegmap_sessions");
-    std::vector<double> insert_ms, drop_ms;
-    std::vector<int64_t> written;
-    for (size_t i = 0; i < o.inserts; ++i) {
-      const NewSession s = tileSession(source, city.offset(city.tiles + i), o.insert_size,
-                                       "insert-" + std::to_string(i));
-      const auto i0 = Clock::now();
-      const SessionWrite w = store->addSession("city", s, snapshot, 1.5);
-      insert_ms.push_back(msSince(i0));
-      snapshot.last_session = w.session;
-      written.push_back(w.session);
-    }
-    for (int64_t id : written) {
-      const auto d0 = Clock::now();
-      store->dropSession("city", id);
-      drop_ms.push_back(msSince(d0));
-    }
-    out["insert"] = {{"entries", o.insert_size},
-                     {"ms", stats(insert_ms)},
-                     {"each_ms", insert_ms},
-                     {"drop_session_ms", stats(drop_ms)}};
-    std::fprintf(stderr, "insert of %zu entries: median %.0f ms\n", o.insert_size,
-                 percentile(insert_ms, 50));
+// Inserts: new sessions at new places (the grid's next cells), then dropped again.
+json insertSessions(const Options& o, PgMapStore& store, const TargetMap& source, const City& city,
+                    const std::string& conninfo) {
+  Sql sql(conninfo);
+  MapSnapshot snapshot;
+  snapshot.last_session = sql.integer("SELECT max(id) FROM semsegmap_sessions");
+  std::vector<double> insert_ms, drop_ms;
+  std::vector<int64_t> written;
+  for (size_t i = 0; i < o.inserts; ++i) {
+    const NewSession s = tileSession(source, city.offset(city.tiles + i), o.insert_size,
+                                     "insert-" + std::to_string(i));
+    const auto i0 = Clock::now();
+    const SessionWrite w = store.addSession("city", s, snapshot, 1.5);
+    insert_ms.push_back(msSince(i0));
+    snapshot.last_session = w.session;
+    written.push_back(w.session);
   }
-  writeJson(o.json, out);
+  for (int64_t id : written) {
+    const auto d0 = Clock::now();
+    store.dropSession("city", id);
+    drop_ms.push_back(msSince(d0));
+  }
+  std::fprintf(stderr, "insert of %zu entries: median %.0f ms\n", o.insert_size,
+               percentile(insert_ms, 50));
+  return {{"entries", o.insert_size},
+          {"ms", stats(insert_ms)},
+          {"each_ms", insert_ms},
+          {"drop_session_ms", stats(drop_ms)}};
+}
 
-  // Localization: the same queries against the region, the source alone and the whole city.
-  const bool perturb = !query_map;
-  const std::vector<Query> queries = makeQueries(query_map ? *query_map : source, perturb, city,
-                                                 o.localizations, o.query_radius_m, rng);
+// Each query against the region loaded around its true place: the load, the index and the
+// localization timed for each query.
+json localizeInRegions(PgMapStore& store, const std::vector<Query>& queries, const City& city,
+                       const LocalizerConfig& config, double radius_m) {
+  Tally tally;
+  std::vector<double> load_ms, index_ms, total_ms, entries_loaded;
+  for (const Query& q : queries) {
+    const Pose T_city_local = translated(city.offset(q.tile), q.T_tile_local);
+    const Eigen::Vector3d at = T_city_local.translation();
+    const auto q0 = Clock::now();
+    auto region =
+        std::make_shared<const TargetMap>(store.load("city", MapRegion{at.x(), at.y(), radius_m}));
+    load_ms.push_back(msSince(q0));
+    entries_loaded.push_back(static_cast<double>(region->size()));
+    const auto b0 = Clock::now();
+    const Localizer localizer(region, config);
+    index_ms.push_back(msSince(b0));
+    tallyOne(localizer, q, T_city_local, city.pitch, tally);
+    total_ms.push_back(load_ms.back() + index_ms.back() + tally.localize_ms.back());
+  }
+  json region = tally.toJson(queries.size());
+  region.update({{"load_ms", stats(load_ms)},
+                 {"index_ms", stats(index_ms)},
+                 {"total_ms", stats(total_ms)},
+                 {"entries", stats(entries_loaded)}});
+  return region;
+}
+
+// The queries against the source map alone, in its own frame: no look-alike tiles.
+json localizeInSource(const TargetMap& source, const std::vector<Query>& queries, const City& city,
+                      const LocalizerConfig& config) {
+  Tally tally;
+  const Localizer localizer(std::make_shared<const TargetMap>(source), config);
+  for (const Query& q : queries) tallyOne(localizer, q, q.T_tile_local, city.pitch, tally);
+  return tally.toJson(queries.size());
+}
+
+// The queries against the region around each and against the source alone; the whole city's
+// file map comes after, once the store is closed.
+void localizeAgainstRegions(const Options& o, const Inputs& in, const City& city, PgMapStore& store,
+                            const std::vector<Query>& queries, const LocalizerConfig& config,
+                            json& out) {
   std::vector<double> local_segments;
   for (const Query& q : queries) local_segments.push_back(static_cast<double>(q.centroids.size()));
-  const LocalizerConfig config;  // k 16, resolution 0.4 m, 6 inliers: config/semsegmap.yaml's
   json loc = {
-      {"queries_from", query_map ? "another run's map (--queries), segments within the query "
-                                   "radius of one of its entries"
-                                 : "the source's own entries, perturbed"},
+      {"queries_from", in.query_map ? "another run's map (--queries), segments within the query "
+                                      "radius of one of its entries"
+                                    : "the source's own entries, perturbed"},
       {"queries", queries.size()},
       {"local_segments", stats(local_segments)},
       {"k", config.index.k},
       {"correct_within", {{"m", kCorrectM}, {"deg", kCorrectDeg}}},
       {"true_candidate_within_m", kTrueCandidateM}};
-  {
-    Tally tally;
-    std::vector<double> load_ms, index_ms, total_ms, entries_loaded;
-    for (const Query& q : queries) {
-      const Pose T_city_local = translated(city.offset(q.tile), q.T_tile_local);
-      const Eigen::Vector3d at = T_city_local.translation();
-      const auto q0 = Clock::now();
-      auto region = std::make_shared<const TargetMap>(
-          store->load("city", MapRegion{at.x(), at.y(), o.radius_m}));
-      load_ms.push_back(msSince(q0));
-      entries_loaded.push_back(static_cast<double>(region->size()));
-      const auto b0 = Clock::now();
-      const Localizer localizer(region, config);
-      index_ms.push_back(msSince(b0));
-      tallyOne(localizer, q, T_city_local, city.pitch, tally);
-      total_ms.push_back(load_ms.back() + index_ms.back() + tally.localize_ms.back());
-    }
-    loc["region"] = tally.toJson(queries.size());
-    loc["region"].update({{"load_ms", stats(load_ms)},
-                          {"index_ms", stats(index_ms)},
-                          {"total_ms", stats(total_ms)},
-                          {"entries", stats(entries_loaded)}});
-  }
-  {
-    Tally tally;
-    const Localizer localizer(std::make_shared<const TargetMap>(source), config);
-    for (const Query& q : queries) tallyOne(localizer, q, q.T_tile_local, city.pitch, tally);
-    loc["single_tile"] = tally.toJson(queries.size());
-  }
+  loc["region"] = localizeInRegions(store, queries, city, config, o.radius_m);
+  loc["single_tile"] = localizeInSource(in.source, queries, city, config);
   out["localization"] = loc;
   writeJson(o.json, out);
   std::fprintf(stderr, "localization against the region: recall %.2f\n",
                loc["region"]["recall"].get<double>());
-  store.reset();
+}
 
-  if (o.file_map) {
-    const std::filesystem::path file = cluster.socketDir() + "/city.map";
-    json f;
-    {
-      auto c0 = Clock::now();
-      const TargetMap whole = cityMap(source, city);
-      f["assemble_s"] = msSince(c0) / 1000.0;
-      c0 = Clock::now();
-      f["bytes"] = saveTargetMap(file, whole);
-      f["save_s"] = msSince(c0) / 1000.0;
-    }
-    auto c0 = Clock::now();
-    auto whole = std::make_shared<const TargetMap>(loadTargetMap(file));
-    f["load_s"] = msSince(c0) / 1000.0;
-    c0 = Clock::now();
-    const double cpu0 = cpuSeconds();
-    const Localizer localizer(whole, config);
-    f["index_s"] = msSince(c0) / 1000.0;
-    f["index_cpu_s"] = cpuSeconds() - cpu0;
-    f["index_lists"] = localizer.index().lists();
-    Tally tally;
-    for (const Query& q : queries)
-      tallyOne(localizer, q, translated(city.offset(q.tile), q.T_tile_local), city.pitch, tally);
-    f.update(tally.toJson(queries.size()));
-    out["localization"]["file"] = f;
-    std::filesystem::remove(file);
-    writeJson(o.json, out);
-    std::fprintf(stderr, "localization against the file map: recall %.2f\n",
-                 f["recall"].get<double>());
-  }
+// The whole city assembled in memory and saved as a map file, each timed; the copy in memory is
+// gone before the file is loaded back.
+json saveCityMap(const TargetMap& source, const City& city, const std::filesystem::path& file) {
+  json f;
+  auto c0 = Clock::now();
+  const TargetMap whole = cityMap(source, city);
+  f["assemble_s"] = msSince(c0) / 1000.0;
+  c0 = Clock::now();
+  f["bytes"] = saveTargetMap(file, whole);
+  f["save_s"] = msSince(c0) / 1000.0;
+  return f;
+}
 
-  if (o.whole_load) {
-    PgMapStore whole_store(parseMapStoreUri(uri));
-    t0 = Clock::now();
-    const TargetMap whole = whole_store.load("city");
-    out["whole_load"] = {{"seconds", msSince(t0) / 1000.0},
-                         {"entries", whole.size()},
-                         {"sessions", whole.sessions.size()}};
-    writeJson(o.json, out);
-  }
+// The same queries against a file map of the whole city (saveTargetMap, loaded and indexed
+// once, each timed apart).
+void localizeInFileMap(const Options& o, const std::filesystem::path& file, const TargetMap& source,
+                       const City& city, const std::vector<Query>& queries,
+                       const LocalizerConfig& config, json& out) {
+  json f = saveCityMap(source, city, file);
+  auto c0 = Clock::now();
+  auto whole = std::make_shared<const TargetMap>(loadTargetMap(file));
+  f["load_s"] = msSince(c0) / 1000.0;
+  c0 = Clock::now();
+  const double cpu0 = cpuSeconds();
+  const Localizer localizer(whole, config);
+  f["index_s"] = msSince(c0) / 1000.0;
+  f["index_cpu_s"] = cpuSeconds() - cpu0;
+  f["index_lists"] = localizer.index().lists();
+  Tally tally;
+  for (const Query& q : queries)
+    tallyOne(localizer, q, translated(city.offset(q.tile), q.T_tile_local), city.pitch, tally);
+  f.update(tally.toJson(queries.size()));
+  out["localization"]["file"] = f;
+  std::filesystem::remove(file);
+  writeJson(o.json, out);
+  std::fprintf(stderr, "localization against the file map: recall %.2f\n",
+               f["recall"].get<double>());
+}
 
+// The whole map loaded from the store (what `map --into` on a store does first).
+void loadWholeCity(const Options& o, const std::string& uri, json& out) {
+  PgMapStore whole_store(parseMapStoreUri(uri));
+  const auto t0 = Clock::now();
+  const TargetMap whole = whole_store.load("city");
+  out["whole_load"] = {{"seconds", msSince(t0) / 1000.0},
+                       {"entries", whole.size()},
+                       {"sessions", whole.sessions.size()}};
+  writeJson(o.json, out);
+}
+
+void finish(const Options& o, Clock::time_point started, json& out) {
   out["peak_rss_mb"] = peakRssMb();
   out["seconds"] = msSince(started) / 1000.0;
   out["machine"]["load_average_at_end"] = loadAverage();
   out["complete"] = true;
   writeJson(o.json, out);
   std::fprintf(stderr, "done in %.0f s: %s\n", msSince(started) / 1000.0, o.json.c_str());
+}
+
+int run(const Options& o) {
+  const auto started = Clock::now();
+  json out = describeRun(o);
+  const Inputs in = loadInputs(o);
+  const City city = layOut(in.source, o.segments, o.margin_m);
+  describeCity(o, in.source, city, out);
+
+  PgCluster cluster(kBuildOptions);
+  if (!cluster.problem().empty())
+    throw std::runtime_error("the bench's PostgreSQL server: " + cluster.problem());
+  Watchdog watchdog(cluster);
+  const std::string uri = cluster.uri("city");
+  const std::string conninfo = parseMapStoreUri(cluster.uri(), false).conninfo;
+  out["server"] = describeServer(conninfo);
+  buildCity(o, in.source, city, uri, conninfo, out);
+
+  std::unique_ptr<PgMapStore> store = restartCold(cluster, uri, out["region_load"]);
+  std::mt19937_64 rng(o.seed);
+  measureRegionLoads(o, *store, uri, randomPlaces(city, o.loads, rng), out);
+  out["insert"] = insertSessions(o, *store, in.source, city, conninfo);
+  writeJson(o.json, out);
+
+  // Localization: the same queries against the region, the source alone and the whole city.
+  // They draw from the generator after the places did: one seed gives both.
+  const bool perturb = !in.query_map;
+  const std::vector<Query> queries = makeQueries(in.query_map ? *in.query_map : in.source, perturb,
+                                                 city, o.localizations, o.query_radius_m, rng);
+  const LocalizerConfig config;  // k 16, resolution 0.4 m, 6 inliers: config/semsegmap.yaml's
+  localizeAgainstRegions(o, in, city, *store, queries, config, out);
+  store.reset();
+
+  if (o.file_map)
+    localizeInFileMap(o, cluster.socketDir() + "/city.map", in.source, city, queries, config, out);
+  if (o.whole_load) loadWholeCity(o, uri, out);
+  finish(o, started, out);
   return 0;
 }
 
