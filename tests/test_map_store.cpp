@@ -489,13 +489,13 @@ TEST(MapStoreCli, MapsJoinsLocalizesListsExportsImportsAndDrops) {
   const std::string uri = "'" + cluster().uri("town") + "'";
   const std::string config = " --config " SEMSEGMAP_SOURCE_DIR "/config/semsegmap.yaml";
   const auto m =
-      runCli("map --dataset sim:world=1,run=S0,preset=tiny,frames=60" + config + " --out " + uri);
+      runCli("map --dataset sim:world=1,run=S0,preset=tiny,frames=45" + config + " --out " + uri);
   ASSERT_EQ(m.code, 0) << m.err;
   const auto again =
       runCli("map --dataset sim:world=1,run=S0,preset=tiny,frames=3" + config + " --out " + uri);
   EXPECT_EQ(again.code, 1);
   EXPECT_NE(again.err.find("map 'town' exists already"), std::string::npos) << again.err;
-  const auto into = runCli("map --dataset sim:world=1,run=S0,preset=tiny,frames=60,traffic=7" +
+  const auto into = runCli("map --dataset sim:world=1,run=S0,preset=tiny,frames=45,traffic=7" +
                            config + " --poses odom --into " + uri + " --out " + uri);
   ASSERT_EQ(into.code, 0) << into.err;
   EXPECT_NE(into.out.find("written into"), std::string::npos) << into.out;
@@ -503,7 +503,7 @@ TEST(MapStoreCli, MapsJoinsLocalizesListsExportsImportsAndDrops) {
   const std::vector<StoredSession> sessions = store.sessions("town");
   ASSERT_EQ(sessions.size(), 2u);
   EXPECT_NE(sessions[1].name.find("traffic=7"), std::string::npos);
-  EXPECT_GT(sessions[1].frames, 50u);
+  EXPECT_EQ(sessions[1].frames, 45u);
 
   const auto list = runCli("maps list --store '" + cluster().uri() + "'");
   ASSERT_EQ(list.code, 0) << list.err;
@@ -517,7 +517,7 @@ TEST(MapStoreCli, MapsJoinsLocalizesListsExportsImportsAndDrops) {
   const TargetMap town = store.load("town");
   for (const MapSegment& s : town.segments) middle += s.centroid / static_cast<float>(town.size());
   const auto localize =
-      runCli("localize --dataset sim:world=1,run=S1,preset=tiny,frames=40" + config + " --map '" +
+      runCli("localize --dataset sim:world=1,run=S1,preset=tiny,frames=25" + config + " --map '" +
              cluster().uri("town") + "&region=" + std::to_string(middle.x()) + "," +
              std::to_string(middle.y()) + ",150' --out " + (tmp.path() / "loc").string());
   ASSERT_EQ(localize.code, 0) << localize.err;

@@ -241,13 +241,13 @@ class MemoryTiles : public MapTileSource {
 // asked for as it moves, as often as with the whole map.
 TEST(MapTiles, ALocalizationFollowsTheTilesAheadAsTheRobotMoves) {
   SEMSEGMAP_SKIP_WITHOUT_SIM();
-  const auto map = mapOf("sim:world=1,run=S0,preset=tiny,frames=150");
-  const std::string spec = "sim:world=1,run=S0,preset=tiny,frames=150,traffic=7";
+  const auto map = mapOf("sim:world=1,run=S0,preset=tiny,frames=110");
+  const std::string spec = "sim:world=1,run=S0,preset=tiny,frames=110,traffic=7";
   auto describer = std::make_shared<OracleDescriber>();
   auto whole_source = openDataset(spec);
   const LocalizationRun whole = runLocalization(*whole_source, config(), map, describer);
   const Eigen::Vector2d start = whole.trajectory_gt.front().translation().head<2>();
-  auto tiles = std::make_shared<MemoryTiles>(map, start, 50.0);
+  auto tiles = std::make_shared<MemoryTiles>(map, start, 25.0);
   const auto first = std::make_shared<const TargetMap>(tiles->around(start.x(), start.y()));
   ASSERT_LT(first->size(), map->size() * 2 / 3) << "the first tiles must not hold the map";
   auto source = openDataset(spec);
@@ -259,7 +259,7 @@ TEST(MapTiles, ALocalizationFollowsTheTilesAheadAsTheRobotMoves) {
   for (const LocalizationRecord& r : tiled.localizations) {
     within += r.translation_error_m < 1.0;
     far_within += r.translation_error_m < 1.0 &&
-                  (r.T_world_base->translation().head<2>() - start).norm() > 80.0;
+                  (r.T_world_base->translation().head<2>() - start).norm() > 60.0;
   }
   for (const LocalizationRecord& r : whole.localizations)
     whole_within += r.translation_error_m < 1.0;

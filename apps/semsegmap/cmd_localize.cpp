@@ -126,7 +126,7 @@ int runLocalize(const CliArgs& a) {
                              " descriptors, the configuration uses " + kind);
   requireDescriberBuilt(config.descriptor);  // a part this build lacks, before the data
   if (a.has("follow")) {
-    FollowedRun followed = followFolder(a, config, map, settings, prior);
+    FollowedRun followed = followFolder(a, config, map, settings, prior, tiles);
     writeLocalizeFiles(a, followed.run, *map, followed.dataset);
     printLocalizationSummary(followed.run);
     printWritten(a);

@@ -176,12 +176,15 @@ int runMap(const CliArgs& a) {
   const uint64_t bytes = saveMapAt(out, map, write, a.get("dataset"));
   const std::string kept =
       earlier ? " + " + std::to_string(earlier) + " earlier observations of them" : "";
+  char size[96] = "in the store";  // a store's size is the server's business
+  if (!isMapStoreUri(out))
+    std::snprintf(size, sizeof size, "%llu bytes (%.1f bytes/segment)",
+                  static_cast<unsigned long long>(bytes),
+                  map.size() ? static_cast<double>(bytes) / map.size() : 0.0);
   std::printf(
-      "frames %zu  segments %zu%s (%zu duplicates removed)  map %zu segments, %llu bytes "
-      "(%.1f bytes/segment)  pipeline %.1f Hz\n",
-      stats.frames, segments, kept.c_str(), duplicates, map.size(),
-      static_cast<unsigned long long>(bytes),
-      map.size() ? static_cast<double>(bytes) / map.size() : 0.0, stats.fps());
+      "frames %zu  segments %zu%s (%zu duplicates removed)  map %zu segments, %s  "
+      "pipeline %.1f Hz\n",
+      stats.frames, segments, kept.c_str(), duplicates, map.size(), size, stats.fps());
   if (stats.labelling) printLabelling(*stats.labelling);
   std::cout << "wrote " << (isMapStoreUri(out) ? parseMapStoreUri(out).shown : out) << "\n";
   if (stats.interrupted)

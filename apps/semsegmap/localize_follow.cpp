@@ -62,7 +62,8 @@ bool feedNewFiles(FolderFollower& follower, LiveSession& live) {
 
 FollowedRun followFolder(const CliArgs& a, const PipelineConfig& config,
                          std::shared_ptr<const TargetMap> map, MapSettingsCheck settings,
-                         const std::optional<RelocalizationPrior>& prior) {
+                         const std::optional<RelocalizationPrior>& prior,
+                         std::shared_ptr<MapTileSource> tiles) {
   FolderFollower follower = openFollower(a);
   // A growing folder has no odometry to read: the LiDAR's, on the scans as they come.
   FrontEndStages stages;
@@ -71,6 +72,7 @@ FollowedRun followFolder(const CliArgs& a, const PipelineConfig& config,
   const std::shared_ptr<Describer> describer = describerFor(config.descriptor, follower.info());
   LocalizationSession session(config, follower.info(), map, describer, settings, stages);
   session.setPrior(prior);
+  session.followTiles(std::move(tiles));
   LiveConfig live_config;
   live_config.assembly.cameras = follower.info().rig.cameras.size();
   live_config.assembly.odometry = false;

@@ -20,8 +20,11 @@ struct FollowedRun {
   std::string dataset;  // the folder's name
 };
 
+// `tiles`: a store map served in tiles (pipeline/map_tiles.h), followed as the robot moves; or
+// nothing.
 FollowedRun followFolder(const CliArgs& a, const PipelineConfig& config,
                          std::shared_ptr<const TargetMap> map, MapSettingsCheck settings,
-                         const std::optional<RelocalizationPrior>& prior);
+                         const std::optional<RelocalizationPrior>& prior,
+                         std::shared_ptr<MapTileSource> tiles = nullptr);
 
 }  // namespace semsegmap::app
