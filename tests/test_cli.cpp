@@ -308,8 +308,9 @@ TEST(Cli, CommandsNotInThisBuildSayWhyInOneLine) {
   if (absent.empty()) GTEST_SKIP() << "this build has every command";
   for (const CommandOptions& c : absent) {
     SCOPED_TRACE(c.command);
-    const std::string option =
-        c.command.rfind("train", 0) == 0 ? "SEMSEGMAP_WITH_TORCH" : "SEMSEGMAP_WITH_SIM";
+    const std::string option = c.command.rfind("train", 0) == 0   ? "SEMSEGMAP_WITH_TORCH"
+                               : c.command.rfind("maps ", 0) == 0 ? "SEMSEGMAP_WITH_POSTGRES"
+                                                                  : "SEMSEGMAP_WITH_SIM";
     for (const std::string& args : {c.command + " --out o", c.command + " --help"}) {
       const Result r = run(args);
       EXPECT_EQ(r.code, 1) << r.err;

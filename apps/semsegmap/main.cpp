@@ -81,8 +81,9 @@ const std::vector<AbsentCommand>& absentCommands() {
   static const std::vector<AbsentCommand> absent = [] {
     std::vector<AbsentCommand> a;
     if (!SEMSEGMAP_WITH_SIM)
-      for (const char* name : {"simulate", "simulate-overview", "eval segmentation",
-                               "eval descriptors", "eval localization", "eval paper", "demo"})
+      for (const char* name :
+           {"simulate", "simulate-overview", "eval segmentation", "eval descriptors",
+            "eval localization", "eval fleet", "eval paper", "demo"})
         a.push_back({name, "SEMSEGMAP_WITH_SIM",
                      "this build has no simulator (built without Embree, reconfigure with "
                      "-DSEMSEGMAP_WITH_SIM=ON)"});
