@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "build_options.h"
+#include "semsegmap/artefacts/map_file.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/core/json.h"
 #include "semsegmap/eval/fleet_experiment.h"
@@ -272,6 +273,11 @@ TEST(FleetExperiment, TwoDrivesMergeWhereTheTruthIsAndAThirdLocalizesInTheWorld)
   const auto j = toJson(e);
   EXPECT_EQ(j["sessions"].size(), 2u);
   EXPECT_NE(fleetTable(e).find("| S0,traffic=7 |"), std::string::npos);
+  TempDir tmp;
+  writeFleetExperiment(e, tmp.path());
+  for (const char* f : {"fleet.json", "fleet.md", "fleet.png"})
+    EXPECT_GT(std::filesystem::file_size(tmp.path() / f), 100u) << f;
+  EXPECT_EQ(loadTargetMap(tmp.path() / "fleet.map").sessions.size(), 2u);
 }
 
 }  // namespace

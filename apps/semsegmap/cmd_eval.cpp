@@ -201,7 +201,7 @@ int runEvalFleet(const CliArgs& a) {
   if (e.interrupted && !progress.started()) return experimentEnd(a, true, progress);
   writeFleetExperiment(e, out);
   std::cout << fleetTable(e) << "wrote " << (out / "fleet.json").string()
-            << ", fleet.md, fleet.map\n";
+            << ", fleet.md, fleet.map, fleet.png\n";
   return experimentEnd(a, e.interrupted, progress);
 }
 

@@ -13,6 +13,7 @@
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/pipeline/session_merge.h"
 #include "semsegmap/settings/config.h"
+#include "semsegmap/viz/trajectory_png.h"
 
 namespace semsegmap {
 
@@ -198,6 +199,8 @@ FleetExperiment runFleetExperiment(const FleetExperimentConfig& config) {
   for (const MapSegment& seg : e.merged.segments) ids.insert(seg.segment);
   e.segments = ids.size();
   judgeCentroids(e, row_of_session, frames, truth);
+  e.trajectories = frames;
+  e.truths = truth;
   for (size_t r = 0; r < row_of_session.size(); ++r)
     e.sessions[row_of_session[r]].trajectory_error_m =
         meanDistance(frames[r], truth[r], e.T_world_map);
@@ -296,8 +299,33 @@ nlohmann::ordered_json toJson(const FleetExperiment& e) {
   return j;
 }
 
+namespace {
+
+// The sessions where the merge put them (through the one alignment) over where they were.
+void writeFleetPng(const FleetExperiment& e, const std::filesystem::path& png) {
+  static const uint8_t kColours[][3] = {{86, 180, 233}, {230, 159, 0}, {0, 158, 115},
+                                        {240, 228, 66}, {213, 94, 0},  {204, 121, 167}};
+  std::vector<viz::TrajectoryCurve> curves;
+  for (size_t k = 0; k < e.truths.size(); ++k)
+    curves.push_back({k == 0 ? "ground truth" : "", 110, 110, 110, e.truths[k]});
+  size_t k = 0;
+  for (const FleetSession& s : e.sessions) {
+    if (!s.aligned) continue;
+    const uint8_t* c = kColours[k % 6];
+    viz::TrajectoryCurve curve{s.run + " in the merged map", c[0], c[1], c[2], {}};
+    for (const Pose& T : e.trajectories[k]) curve.poses.push_back(e.T_world_map * T);
+    curves.push_back(std::move(curve));
+    ++k;
+  }
+  viz::writeTrajectoriesPng(png, "fleet: sessions merged into one map, against the truth", curves,
+                            {});
+}
+
+}  // namespace
+
 void writeFleetExperiment(const FleetExperiment& e, const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
+  writeFleetPng(e, dir / "fleet.png");
   saveTargetMap(dir / "fleet.map", e.merged);
   writeBytesAtomically(dir / "fleet.json", toJson(e).dump(2) + "\n");
   writeBytesAtomically(dir / "fleet.md", fleetTable(e));

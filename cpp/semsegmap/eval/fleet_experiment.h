@@ -60,6 +60,8 @@ struct FleetExperiment {
   Pose T_world_map = Pose::Identity();
   std::vector<FleetQuery> queries;
   TargetMap merged;
+  // Per aligned session (in order): its frames' poses in the map, and their true poses.
+  std::vector<std::vector<Pose>> trajectories, truths;
   bool interrupted = false;
 };
 
@@ -69,7 +71,8 @@ FleetExperiment runFleetExperiment(const FleetExperimentConfig& config);
 std::string fleetTable(const FleetExperiment& e);
 nlohmann::ordered_json toJson(const FleetExperiment& e);
 
-// fleet.json, fleet.map (the merged map) and fleet.md (the table) into `dir`.
+// fleet.json, fleet.map (the merged map), fleet.md (the table) and fleet.png (each session's
+// trajectory in the world through the one alignment, over the truth in grey) into `dir`.
 void writeFleetExperiment(const FleetExperiment& e, const std::filesystem::path& dir);
 
 }  // namespace semsegmap

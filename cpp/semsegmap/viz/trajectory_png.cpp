@@ -24,8 +24,10 @@ void writeTrajectoriesPng(const std::filesystem::path& png, const std::string& t
   hi += Eigen::Vector2d::Constant(20.0);
   const double mpp = std::max(0.1, std::max(hi.x() - lo.x(), hi.y() - lo.y()) / 1600.0);
   const int w = static_cast<int>((hi.x() - lo.x()) / mpp) + 1;
-  const int h =
-      static_cast<int>((hi.y() - lo.y()) / mpp) + 1 + 30 * static_cast<int>(curves.size());
+  // A curve without a name (one more piece of a curve named before) gets no legend row.
+  const auto rows = static_cast<int>(std::count_if(
+      curves.begin(), curves.end(), [](const TrajectoryCurve& c) { return !c.name.empty(); }));
+  const int h = static_cast<int>((hi.y() - lo.y()) / mpp) + 1 + 30 * rows;
   cv::Mat canvas(h, w, CV_8UC3, cv::Scalar(24, 24, 24));
   auto px = [&](const Eigen::Vector3d& p) {
     return cv::Point(static_cast<int>((p.x() - lo.x()) / mpp),
@@ -33,13 +35,14 @@ void writeTrajectoriesPng(const std::filesystem::path& png, const std::string& t
   };
   for (const auto& [a, b] : links)
     cv::line(canvas, px(a), px(b), cv::Scalar(60, 200, 255), 1, cv::LINE_AA);
-  for (size_t k = 0; k < curves.size(); ++k) {
-    const TrajectoryCurve& c = curves[k];
+  int row = 0;
+  for (const TrajectoryCurve& c : curves) {
     std::vector<cv::Point> path;
     for (const auto& T : c.poses) path.push_back(px(T.translation()));
     const cv::Scalar color(c.b, c.g, c.r);
     if (path.size() > 1) cv::polylines(canvas, path, false, color, 2, cv::LINE_AA);
-    const int y = h - 12 - 30 * static_cast<int>(curves.size() - 1 - k);
+    if (c.name.empty()) continue;
+    const int y = h - 12 - 30 * (rows - 1 - row++);
     cv::line(canvas, {12, y - 5}, {42, y - 5}, color, 3);
     drawLabel(canvas, c.name, {50, y}, 0.55);
   }
