@@ -38,18 +38,10 @@ std::string separateLocation(const std::string& out, int64_t now_unix_s) {
 // The map a session joins, and what it was when loaded: a store's map is read whole (the session
 // may have driven anywhere in it).
 TargetMap loadMapToJoin(const std::string& into, MapSnapshot& snapshot) {
-  if (!isMapStoreUri(into)) return loadTargetMap(into);
-  requireMapStoreBuilt(into);
-#if SEMSEGMAP_WITH_POSTGRES
-  const MapStoreUri uri = parseMapStoreUri(into);
-  if (uri.region)
-    throw UsageError("--into " + uri.shown + ": a session joins the whole map, drop region=");
-  PgMapStore store(uri);
-  return store.load(uri.map, {}, &snapshot);
-#else
-  (void)snapshot;
-  return {};
-#endif
+  if (isMapStoreUri(into) && parseMapStoreUri(into).region)
+    throw UsageError("--into " + shownLocation(into) +
+                     ": a session joins the whole map, drop region=");
+  return loadMapAt(into, &snapshot);
 }
 
 // The merged map's new session, written in place into the store map it joined (one
@@ -97,7 +89,7 @@ int runMapInto(const CliArgs& a, const PipelineConfig& config, DatasetWithStages
               << " times against " << mapDisplayName(into) << " ("
               << config.session_merge.min_localizations
               << " needed): not merged; its own map, in its own frame, written to "
-              << (isMapStoreUri(separate) ? parseMapStoreUri(separate).shown : separate) << "\n";
+              << shownLocation(separate) << "\n";
     return 3;
   }
   std::set<uint32_t> segments;
@@ -109,7 +101,7 @@ int runMapInto(const CliArgs& a, const PipelineConfig& config, DatasetWithStages
       m.mapping.stats.frames, m.ties.size(), mapDisplayName(into).c_str(), m.mean_tie_residual_m,
       m.entries, m.same_segments, m.map.sessions.size(), m.map.size(), segments.size());
   writeJoined(into, out, m, snapshot, config, write, a.get("dataset"));
-  std::cout << "wrote " << (isMapStoreUri(out) ? parseMapStoreUri(out).shown : out) << "\n";
+  std::cout << "wrote " << shownLocation(out) << "\n";
   if (m.mapping.stats.interrupted)
     return interruptedRun("map", m.mapping.stats.frames, options.frameCount(*data.source), out);
   return 0;
@@ -186,7 +178,7 @@ int runMap(const CliArgs& a) {
       "pipeline %.1f Hz\n",
       stats.frames, segments, kept.c_str(), duplicates, map.size(), size, stats.fps());
   if (stats.labelling) printLabelling(*stats.labelling);
-  std::cout << "wrote " << (isMapStoreUri(out) ? parseMapStoreUri(out).shown : out) << "\n";
+  std::cout << "wrote " << shownLocation(out) << "\n";
   if (stats.interrupted)
     return interruptedRun("map", stats.frames, options.frameCount(*source), out);
   return 0;

@@ -4,9 +4,6 @@
 #include <stdexcept>
 
 #include "semsegmap/store/map_store_uri.h"
-#if SEMSEGMAP_WITH_POSTGRES
-#include "semsegmap/store/pg_map_store.h"
-#endif
 
 namespace semsegmap {
 
@@ -17,20 +14,25 @@ void requireMapStoreBuilt(const std::string& where) {
                            "-DSEMSEGMAP_WITH_POSTGRES=ON, libpq-dev)");
 }
 
+std::string shownLocation(const std::string& where) {
+  return isMapStoreUri(where) ? parseMapStoreUri(where, false).shown : where;
+}
+
 std::string mapDisplayName(const std::string& where) {
   if (!isMapStoreUri(where)) return std::filesystem::path(where).filename().string();
   const MapStoreUri uri = parseMapStoreUri(where, false);
   return uri.map.empty() ? uri.shown : uri.map;
 }
 
-TargetMap loadMapAt(const std::string& where) {
+TargetMap loadMapAt(const std::string& where, MapSnapshot* snapshot) {
   if (!isMapStoreUri(where)) return loadTargetMap(where);
   requireMapStoreBuilt(where);
 #if SEMSEGMAP_WITH_POSTGRES
   const MapStoreUri uri = parseMapStoreUri(where);
   PgMapStore store(uri);
-  return store.load(uri.map, uri.region);
+  return store.load(uri.map, uri.region, snapshot);
 #else
+  (void)snapshot;
   throw std::logic_error("requireMapStoreBuilt let a store URI through");
 #endif
 }

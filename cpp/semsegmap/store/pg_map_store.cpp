@@ -327,7 +327,7 @@ PgMapStore::~PgMapStore() {
   PQfinish(conn_);
 }
 
-int PgMapStore::mapId(const std::string& name, bool lock) {
+int PgMapStore::mapId(const std::string& name) {
   const Result r = run(conn_, shown_, "looking up map " + name,
                        "SELECT id FROM semsegmap_maps WHERE name = $1", {name});
   if (r.rows() == 0) {
@@ -336,12 +336,7 @@ int PgMapStore::mapId(const std::string& name, bool lock) {
     throw std::runtime_error(shown_ + ": no map named '" + name + "' in the store (" +
                              (known.empty() ? "it holds none" : "it holds " + known) + ")");
   }
-  const int id = static_cast<int>(r.integer(0, 0));
-  if (lock)
-    run(conn_, shown_, "locking map " + name,
-        "SELECT pg_advisory_xact_lock(" + std::to_string(kLockSpace + kLockMap) + ", $1)",
-        {std::to_string(id)});
-  return id;
+  return static_cast<int>(r.integer(0, 0));
 }
 
 bool PgMapStore::exists(const std::string& name) {
@@ -376,14 +371,14 @@ GROUP BY m.id ORDER BY m.name)sql");
 }
 
 StoredMap PgMapStore::show(const std::string& name) {
-  mapId(name, false);  // the error naming the maps there are
+  mapId(name);  // the error naming the maps there are
   for (StoredMap& m : list())
     if (m.name == name) return m;
   throw std::runtime_error(shown_ + ": map '" + name + "' was dropped meanwhile");
 }
 
 std::vector<StoredSession> PgMapStore::sessions(const std::string& name) {
-  const int id = mapId(name, false);
+  const int id = mapId(name);
   const Result r = run(conn_, shown_, "listing the sessions of " + name, R"sql(
 SELECT s.id, s.name, s.merged_unix_s, s.frames,
   (SELECT count(*) FROM semsegmap_segments g WHERE g.session_id = s.id)
@@ -533,7 +528,7 @@ TargetMap PgMapStore::loadSelected(const std::string& name, const Selection& sel
   // A region's few thousand rows come from the spatial index in about a millisecond; a parallel
   // plan, which PostgreSQL picks for larger discs, spends 100 ms starting its worker.
   run(conn_, shown_, doing, "SET LOCAL max_parallel_workers_per_gather = 0");
-  const int id = mapId(name, false);
+  const int id = mapId(name);
   const std::string sid = std::to_string(id);
   const Result head = run(conn_, shown_, doing,
                           "SELECT descriptor, fingerprint, dimension, format_version, "
@@ -742,7 +737,8 @@ SessionWrite PgMapStore::addSession(const std::string& name, const NewSession& s
   if (static_cast<size_t>(session.descriptors.rows()) != session.entries.size())
     throw std::invalid_argument(shown_ + ": " + doing + ": entries and descriptors differ");
   Transaction t(conn_, shown_, doing);
-  const int id = mapId(name, /*lock=*/true);
+  const int id = mapId(name);
+  t.lock(kLockMap, "$1", {std::to_string(id)});
   const std::string sid = std::to_string(id);
   const int64_t dimension =
       run(conn_, shown_, doing, "SELECT dimension FROM semsegmap_maps WHERE id = $1", {sid})
@@ -793,7 +789,8 @@ SessionWrite PgMapStore::addSession(const std::string& name, const NewSession& s
 
 void PgMapStore::drop(const std::string& name) {
   Transaction t(conn_, shown_, "dropping map " + name);
-  const int id = mapId(name, /*lock=*/true);
+  const int id = mapId(name);
+  t.lock(kLockMap, "$1", {std::to_string(id)});
   run(conn_, shown_, "dropping map " + name, "DELETE FROM semsegmap_maps WHERE id = $1",
       {std::to_string(id)});
   t.commit();
@@ -802,7 +799,8 @@ void PgMapStore::drop(const std::string& name) {
 void PgMapStore::dropSession(const std::string& name, int64_t session) {
   const std::string doing = "dropping session " + std::to_string(session) + " of map " + name;
   Transaction t(conn_, shown_, doing);
-  const int id = mapId(name, /*lock=*/true);
+  const int id = mapId(name);
+  t.lock(kLockMap, "$1", {std::to_string(id)});
   const Result r =
       run(conn_, shown_, doing, "DELETE FROM semsegmap_sessions WHERE id = $1 AND map_id = $2",
           {std::to_string(session), std::to_string(id)});

@@ -108,7 +108,8 @@ class PgMapStore {
  private:
   TargetMap loadSelected(const std::string& name, const Selection& selection,
                          MapSnapshot* snapshot);
-  int mapId(const std::string& name, bool lock);
+  // The map's id; throws, naming the maps there are, for one the store has not.
+  int mapId(const std::string& name);
   PGconn* conn_ = nullptr;
   std::string shown_;
 };
