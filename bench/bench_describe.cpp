@@ -1,6 +1,7 @@
 // Learned descriptor inference, batched, on synthetic segments of simulated size (500-3000
 // points: boxes, walls, trunks, crowns with colours and classes). Targets on 2 cores:
-// semsegmap-net >= 300 segments/s, segmap-cnn >= 1000 segments/s (items_per_second).
+// semsegmap-net >= 300 segments/s, segmap-cnn >= 1000 segments/s (items_per_second); 3dsmoothnet
+// is a baseline of retrieval, without a target: its time is reported.
 // Randomly initialised weights: the speed does not depend on their values.
 #include <benchmark/benchmark.h>
 
@@ -12,6 +13,7 @@
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/describe/learned_describer.h"
 #include "semsegmap/describe/learned_net.h"
+#include "semsegmap/describe/smoothnet.h"
 
 using namespace semsegmap;
 
@@ -79,6 +81,7 @@ std::string modelFile(DescriptorKind kind) {
   if (!std::filesystem::exists(path)) {
     NetConfig config;
     config.kind = kind;
+    if (kind == DescriptorKind::kSmoothNetBow) config.descriptor_dim = 16;  // its visual words
     torch::manual_seed(1);
     saveNet(path, *makeNet(config));
     models.paths.push_back(path);
@@ -86,7 +89,8 @@ std::string modelFile(DescriptorKind kind) {
   return path.string();
 }
 
-// state.range(0): descriptor kind (2 segmap-cnn, 3 semsegmap-net); range(1): threads.
+// state.range(0): descriptor kind (2 segmap-cnn, 3 semsegmap-net, 4 3dsmoothnet); range(1):
+// threads.
 void BM_LearnedDescribe(benchmark::State& state) {
   const KeepOpenMpThreads keep;  // later benchmarks run OpenMP loops in this thread
   const auto kind = static_cast<DescriptorKind>(state.range(0));
@@ -104,7 +108,8 @@ void BM_LearnedDescribe(benchmark::State& state) {
 }
 BENCHMARK(BM_LearnedDescribe)
     ->ArgsProduct({{static_cast<int>(DescriptorKind::kSegMapCnn),
-                    static_cast<int>(DescriptorKind::kSemSegMapNet)},
+                    static_cast<int>(DescriptorKind::kSemSegMapNet),
+                    static_cast<int>(DescriptorKind::kSmoothNetBow)},
                    {1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
@@ -116,12 +121,13 @@ void BM_LearnedNetInput(benchmark::State& state) {
   torch::set_num_threads(1);
   NetConfig config;
   config.kind = static_cast<DescriptorKind>(state.range(0));
+  if (config.kind == DescriptorKind::kSmoothNetBow) config.descriptor_dim = 16;
   std::vector<const EnrichedCloud*> batch;
   for (const EnrichedCloud& s : segments()) batch.push_back(&s);
   const std::vector<uint64_t> salts(batch.size(), 1);
   for (auto _ : state) {
     NetInput in = makeNetInput(config, batch, salts);
-    benchmark::DoNotOptimize(in.scale.data_ptr<float>());
+    benchmark::DoNotOptimize(in.n_points.data_ptr<float>());
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(batch.size()));
   state.SetLabel(descriptorName(config.kind));
@@ -129,6 +135,37 @@ void BM_LearnedNetInput(benchmark::State& state) {
 BENCHMARK(BM_LearnedNetInput)
     ->Arg(static_cast<int>(DescriptorKind::kSegMapCnn))
     ->Arg(static_cast<int>(DescriptorKind::kSemSegMapNet))
+    ->Arg(static_cast<int>(DescriptorKind::kSmoothNetBow))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+
+namespace {
+
+// 3dsmoothnet's network alone on a batch of range(0) SDV grids, one thread: where its describing
+// time goes.
+void BM_SmoothNetLocal(benchmark::State& state) {
+  const KeepOpenMpThreads keep;
+  torch::set_num_threads(1);
+  NetConfig config;
+  config.kind = DescriptorKind::kSmoothNetBow;
+  config.descriptor_dim = 16;
+  torch::manual_seed(1);
+  SmoothNetImpl net(config);
+  net.eval();
+  const torch::NoGradGuard no_grad;
+  const torch::Tensor grids = torch::rand({state.range(0), 1, 16, 16, 16}) / 4096.0f;
+  for (auto _ : state) {
+    torch::Tensor d = net.local(grids);
+    benchmark::DoNotOptimize(d.data_ptr<float>());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_SmoothNetLocal)
+    ->Arg(32)
+    ->Arg(64)
+    ->Arg(256)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -131,7 +131,10 @@ const std::vector<CommandOptions> kAllCommands = {
       "distillation-weight",
       "from-scratch",
       "points",
-      "history"},
+      "history",
+      "words",
+      "keypoints",
+      "steps"},
      {"world-seed", "map"}},
     {"demo", {"out", "world-seed", "preset", "max-frames"}, {"configs", "dataset"}},
     {"eval segmentation",
@@ -679,6 +682,42 @@ TEST(CliMapInto, ARunJoinsAMapAsASessionOrIsWrittenBeside) {
 
 // A teacher is checked before the extraction (here the dataset does not even exist): the options
 // that need it, its file and its kind.
+// 3dsmoothnet's training takes the options it has a use for, refuses the others before any
+// extraction, and writes a model whose words are fitted, which eval descriptors then ranks.
+TEST(Cli, TrainsThreeDSmoothNetAndRefusesTheOptionsOfTheOthers) {
+  if (!built("train")) GTEST_SKIP() << "this build has no train (SEMSEGMAP_WITH_TORCH=OFF)";
+  TempDir tmp;
+  const std::string model = (tmp.path() / "3dsmoothnet.model").string();
+  const std::string train = "train --dataset sim:nowhere --out " + model + " ";
+  const Result teacher =
+      run(train + "--descriptor 3dsmoothnet --teacher models/semsegmap-net.model");
+  EXPECT_EQ(teacher.code, 2);
+  EXPECT_NE(teacher.err.find("--teacher: not an option of 3dsmoothnet's training"),
+            std::string::npos)
+      << teacher.err;
+  const Result words = run(train + "--descriptor semsegmap-net --words 8");
+  EXPECT_EQ(words.code, 2);
+  EXPECT_NE(words.err.find("--words: only for 3dsmoothnet"), std::string::npos) << words.err;
+  const Result one = run(train + "--descriptor 3dsmoothnet --words 1");
+  EXPECT_EQ(one.code, 1);
+  EXPECT_NE(one.err.find("visual words"), std::string::npos) << one.err;
+  if (!built("simulate")) return;
+  const Result r =
+      run("train --descriptor 3dsmoothnet --dataset sim:world=1,run=S1,preset=tiny --max-frames 40 "
+          "--epochs 1 --steps 4 --batch 16 --keypoints 8 --words 4 --out " +
+          model);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("fitted 4 visual words to "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("segment retrieval on the validation objects"), std::string::npos) << r.out;
+  // A model file of version 4 naming its kind, with the words last (tests/test_smoothnet.cpp
+  // reads such files back).
+  const std::string bytes = readFile(model);
+  EXPECT_EQ(bytes.substr(0, 7), std::string("SSMNET\x04", 7));
+  EXPECT_NE(bytes.find("3dsmoothnet"), std::string::npos);
+  EXPECT_NE(bytes.rfind("words"), std::string::npos);
+  EXPECT_NE(r.out.find("(3dsmoothnet, fingerprint "), std::string::npos) << r.out;
+}
+
 TEST(Cli, TrainChecksItsTeacherBeforeExtracting) {
   if (!built("train")) GTEST_SKIP() << "this build has no train (SEMSEGMAP_WITH_TORCH=OFF)";
   TempDir tmp;
@@ -1403,6 +1442,35 @@ std::string interruptedLine(const std::string& err, const std::string& prefix) {
   return err.substr(at, err.find('\n', at) - at);
 }
 
+// `make demo`'s command to its end on a few frames of the tiny world: the results table with both
+// configurations and both label passes, the report and its pictures, the viewer's page. (CI runs
+// this instead of the whole demo beside its builds, where it took a core for 17 minutes.)
+TEST(CliDemo, RunsToItsEndAndPrintsTheTableWithTheNetworkRows) {
+  if (!built("demo")) GTEST_SKIP() << "demo needs the simulator";
+  if (!SEMSEGMAP_WITH_TORCH) GTEST_SKIP() << "demo's SemSegMap configuration needs libtorch";
+  TempDir tmp;
+  const std::filesystem::path out = tmp.path() / "demo";
+  const Result r = run("demo --preset tiny --max-frames 30 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("| run | config | localizations | < 1 m |"), std::string::npos) << r.out;
+  for (const char* row : {"| S2 | semsegmap | ", "| S2 | segmap | ", "| S2 | semsegmap, network | ",
+                          "| S3 | semsegmap | ", "| S3 | segmap, network | "})
+    EXPECT_NE(r.out.find(row), std::string::npos) << row << "\n" << r.out;
+  EXPECT_NE(r.out.find("wrote " + (out / "report.md").string()), std::string::npos) << r.out;
+  // SemSegMap localizes on S2 within its first 30 frames (the table's third column).
+  const size_t row = r.out.find("| S2 | semsegmap | ");
+  ASSERT_NE(row, std::string::npos);
+  EXPECT_GT(std::stoi(r.out.substr(row + std::string("| S2 | semsegmap | ").size())), 0) << r.out;
+  for (const char* file : {"report.md", "overview.png", "localization_accuracy.png",
+                           "localization.json", "semsegmap_S3/localization.png"})
+    EXPECT_GT(std::filesystem::file_size(out / file), 100u) << file;
+  if (built("view")) {
+    EXPECT_TRUE(std::filesystem::exists(out / "view.html"));
+  }
+  EXPECT_EQ(readFile(out / "report.md").find("Partial: interrupted"), std::string::npos);
+  EXPECT_EQ(temporaryFiles(tmp.path()), std::vector<std::string>{});
+}
+
 // Ctrl-C during `demo`'s S2 run: the frame in hand finishes, the S2 folders are written whole
 // with its frames done, S3 never starts, localization.json and report.md say interrupted.
 TEST(CliInterrupt, AnInterruptedDemoWritesTheRunsDoneMarkedInterrupted) {
@@ -2109,14 +2177,39 @@ std::vector<DocumentedCommand> documentedCommands() {
 // Every `build/semsegmap ...` line of the README, docs/, the model card and fuzz/README.md
 // parses as its command would (`semsegmap --check-usage`): a renamed option or a placeholder
 // read as a list of choices breaks this test, not a user's first try.
+// All lines in one `--check-usage-lines` process: one by one, the program's start made this the
+// slowest test of the suite (three minutes in CI).
 TEST(Docs, EveryCommandLineTheDocumentationShowsParses) {
   const std::vector<DocumentedCommand> commands = documentedCommands();
   ASSERT_GE(commands.size(), 40u) << "the README and docs show that many";
+  TempDir tmp;
+  const std::filesystem::path lines = tmp.path() / "lines.txt";
+  {
+    std::ofstream out(lines);
+    for (const DocumentedCommand& c : commands) out << expanded(c.line, c.variables) << "\n";
+  }
+  const Result all = run("--check-usage-lines '" + lines.string() + "'");
+  // Per line: "--- line N exit C", its output, "--- stderr", its errors.
+  std::vector<Result> results;
+  std::istringstream printed(all.out);
+  bool in_err = false;
+  for (std::string line; std::getline(printed, line);) {
+    int number = 0, code = 0;
+    if (std::sscanf(line.c_str(), "--- line %d exit %d", &number, &code) == 2) {
+      results.push_back({code, "", ""});
+      in_err = false;
+    } else if (line == "--- stderr") {
+      in_err = true;
+    } else if (!results.empty()) {
+      (in_err ? results.back().err : results.back().out) += line + "\n";
+    }
+  }
+  ASSERT_EQ(results.size(), commands.size()) << all.out << all.err;
   size_t checked = 0;
-  for (const DocumentedCommand& c : commands) {
+  for (size_t i = 0; i < commands.size(); ++i) {
+    const DocumentedCommand& c = commands[i];
+    const Result& r = results[i];
     SCOPED_TRACE(c.where + ": build/semsegmap " + c.line);
-    for (const auto& [name, value] : c.variables) ::setenv(name.c_str(), value.c_str(), 1);
-    const Result r = run("--check-usage " + c.line);
     // This build may leave a command out (the SEMSEGMAP_WITH_* options): it says so. A build with
     // the simulator and libtorch may still lack the viewer (no Node.js), and nothing else.
     if (r.code == 1 && r.err.find("this build has no") != std::string::npos) {
@@ -2130,6 +2223,27 @@ TEST(Docs, EveryCommandLineTheDocumentationShowsParses) {
     ++checked;
   }
   EXPECT_GE(checked, 10u);
+}
+
+// The batch form says which line is wrong and still checks the others.
+TEST(Docs, CheckUsageLinesChecksEachLineOnItsOwn) {
+  TempDir tmp;
+  const std::filesystem::path lines = tmp.path() / "lines.txt";
+  {
+    std::ofstream out(lines);
+    out << "map --dataset folder:nowhere --config c.yaml --out 'a b.map'\n\nmap --bogus "
+           "1\nlocalize \"unclosed\n";
+  }
+  const Result r = run("--check-usage-lines '" + lines.string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--- line 1 exit 0\nsemsegmap map: usage ok"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--- line 3 exit 2"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--bogus"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--- line 4 exit 2\n--- stderr\nsemsegmap --check-usage-lines: line 4 is no "
+                       "command line a shell splits"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(run("--check-usage-lines '" + (tmp.path() / "none.txt").string() + "'").code, 1);
 }
 
 TEST(Docs, CheckUsageRefusesWhatTheCommandWouldAndRunsNothing) {

@@ -418,10 +418,10 @@ TEST(ModelFile, RoundTripAndErrors) {
     expectFileError([&] { loadNet(truncated); }, truncated, "truncated");
 
     std::string other_version = bytes;
-    other_version[6] = 4;  // the format version follows the 6-byte magic
+    other_version[6] = 5;  // the format version follows the 6-byte magic
     const auto future = dir / "future.ssmnet";
     writeBytes(future, other_version);
-    expectFileError([&] { loadNet(future); }, future, "version 4");
+    expectFileError([&] { loadNet(future); }, future, "version 5");
 
     const auto bad_magic = dir / "bad_magic.ssmnet";
     writeBytes(bad_magic, "X" + bytes.substr(1));
@@ -491,7 +491,7 @@ TEST(ModelFile, ModalitiesAreRecordedFingerprintedAndApplied) {
   EXPECT_NE(netFingerprint(*lidar), netFingerprint(*net));
   const auto path = dir / "lidar.ssmnet";
   saveNet(path, *lidar);
-  EXPECT_EQ(readBytes(path)[6], 3) << "format version 3 records the modalities";
+  EXPECT_EQ(readBytes(path)[6], 4) << "format version 3 on records the modalities";
   const Model model = readModelFile(path);
   EXPECT_FALSE(model.config.use_color);
   EXPECT_FALSE(model.config.use_classes);
@@ -513,9 +513,13 @@ TEST(ModelFile, ModalitiesAreRecordedFingerprintedAndApplied) {
 // The shapes a configuration implies, without torch (net_config.h), are those of the networks.
 TEST(ModelFile, TensorShapesOfAConfigurationAreThoseOfItsNetwork) {
   std::vector<NetConfig> configs;
-  for (const DescriptorKind kind : {DescriptorKind::kSemSegMapNet, DescriptorKind::kSegMapCnn}) {
+  for (const DescriptorKind kind :
+       {DescriptorKind::kSemSegMapNet, DescriptorKind::kSegMapCnn, DescriptorKind::kSmoothNetBow}) {
     configs.push_back(tinyConfig(kind));
     NetConfig other = tinyConfig(kind);
+    other.smoothnet_voxels = 8;
+    other.smoothnet_width = 3;
+    other.smoothnet_local_dim = 5;
     other.recon_grid = 32;
     other.pointnet_width = 3;
     other.cnn_width = 5;

@@ -57,8 +57,9 @@ std::vector<std::string> descriptorList(const CliArgs& a) {
 // The default of --descriptors: every descriptor this build has, the learned ones first.
 std::string builtDescriptors() {
   std::string list;
-  for (const DescriptorKind kind : {DescriptorKind::kSemSegMapNet, DescriptorKind::kSegMapCnn,
-                                    DescriptorKind::kFpfh, DescriptorKind::kEigen})
+  for (const DescriptorKind kind :
+       {DescriptorKind::kSemSegMapNet, DescriptorKind::kSegMapCnn, DescriptorKind::kSmoothNetBow,
+        DescriptorKind::kFpfh, DescriptorKind::kEigen})
     if (descriptorNotBuilt(kind).empty()) list += (list.empty() ? "" : ",") + descriptorName(kind);
   return list;
 }

@@ -15,6 +15,7 @@
 #include "semsegmap/artefacts/training_cache.h"
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/datasets/dataset_specs.h"
+#include "semsegmap/learn/smoothnet_trainer.h"
 #include "semsegmap/learn/trainer.h"
 #include "semsegmap/settings/config.h"
 
@@ -80,8 +81,13 @@ TrainingSet loadOrExtract(const std::vector<std::string>& specs, const PipelineC
 // on a terminal, a line every tenth of an epoch or 30 s into a log).
 class EpochProgress {
  public:
-  EpochProgress(int epochs, bool distilled)
-      : epochs_(epochs), distilled_(distilled), start_(std::chrono::steady_clock::now()) {}
+  // `keypoints`: 3dsmoothnet's epochs, whose loss is over keypoint pairs and whose validation
+  // ranks keypoints, not segments.
+  EpochProgress(int epochs, bool distilled, bool keypoints = false)
+      : epochs_(epochs),
+        distilled_(distilled),
+        keypoints_(keypoints),
+        start_(std::chrono::steady_clock::now()) {}
 
   void step(int epoch, size_t done, size_t total, double loss) {
     if (epoch != epoch_) {
@@ -104,6 +110,15 @@ class EpochProgress {
     std::snprintf(text, sizeof text, "val top1 %.3f top5 %.3f", s.validation.top1,
                   s.validation.top5);
     validation_ = text;
+    if (keypoints_) {
+      std::printf(
+          "epoch %d  loss %.4f  keypoints' counterparts top1 %.3f top5 %.3f (%zu pairs)"
+          "  %.0f s%s\n",
+          s.epoch, s.loss, s.validation.top1, s.validation.top5, s.validation.queries, s.seconds,
+          s.best ? "  best" : "");
+      std::fflush(stdout);
+      return;
+    }
     char distillation[48] = "";
     if (distilled_)
       std::snprintf(distillation, sizeof distillation, ", distillation %.4f", s.distillation_loss);
@@ -121,6 +136,7 @@ class EpochProgress {
   }
   int epochs_;
   bool distilled_;
+  bool keypoints_;
   std::chrono::steady_clock::time_point start_;
   int epoch_ = 0;
   ProgressLine line_;
@@ -230,11 +246,9 @@ int trainEnd(const CliArgs& a, const TrainConfig& config, const TrainResult& res
                              ", the best of the " + std::to_string(epochs) + " epochs done");
 }
 
-int runTrain(const CliArgs& a) {
-  const TrainConfig config = trainConfig(a);
-  const auto teacher = loadTeacher(a, config);
+// The observations of --dataset (or --cache), with the pipeline of --config.
+TrainingSet trainingData(const CliArgs& a) {
   const std::vector<std::string> specs = splitDatasetSpecs(a.get("dataset"));
-  const std::filesystem::path out = a.get("out");
   ExtractionConfig extraction;
   extraction.max_frames = a.frameLimit();
   // Without --config, the built-in defaults (those of config/semsegmap.yaml).
@@ -244,25 +258,91 @@ int runTrain(const CliArgs& a) {
     pipeline = loadPipelineConfig(a.get("config"));
     config_text = readFileBytes(a.get("config"));
   }
-
   extraction.stop = stopToken();
-  const TrainingSet data =
-      loadOrExtract(specs, pipeline, config_text, extraction, a.has("cache") ? a.get("cache") : "");
-  if (data.interrupted) return interruptedWork("train", "while extracting the training data", "");
-  EpochProgress progress(config.epochs, teacher != nullptr);
+  return loadOrExtract(specs, pipeline, config_text, extraction,
+                       a.has("cache") ? a.get("cache") : "");
+}
+
+// Ctrl-C, the progress line, and the history so far written to its file after every epoch,
+// before the epoch is printed: a run stopped early (a day's budget, a killed job) keeps both its
+// best model and its history.
+TrainCallbacks epochCallbacks(const CliArgs& a, EpochProgress& progress,
+                              std::vector<EpochStats>& history) {
   TrainCallbacks callbacks;
   callbacks.stop = stopToken();
-  callbacks.step = [&](int epoch, size_t done, size_t total, double loss) {
+  callbacks.step = [&progress](int epoch, size_t done, size_t total, double loss) {
     progress.step(epoch, done, total, loss);
   };
-  // The history so far goes to its file after every epoch, before the epoch is printed: a run
-  // stopped early (a day's budget, a killed job) keeps both its best model and its history.
-  std::vector<EpochStats> history;
-  callbacks.epoch = [&](const EpochStats& s) {
+  callbacks.epoch = [&a, &progress, &history](const EpochStats& s) {
     history.push_back(s);
     if (a.has("history")) writeHistoryCsv(a.get("history"), history);
     progress.epoch(s);
   };
+  return callbacks;
+}
+
+// The options of the segment descriptors' training that 3dsmoothnet has no use for.
+constexpr const char* kNotForSmoothNet[] = {
+    "anchors-per-epoch",   "confused-sections", "modality-dropout",
+    "partial-coverage",    "lidar-only",        "teacher",
+    "distillation-weight", "from-scratch",      "points"};
+// ... and those only it has.
+constexpr const char* kOnlyForSmoothNet[] = {"words", "keypoints", "steps"};
+
+SmoothNetTrainConfig smoothNetTrainConfig(const CliArgs& a) {
+  for (const char* option : kNotForSmoothNet)
+    if (a.has(option))
+      throw UsageError(std::string("--") + option + ": not an option of 3dsmoothnet's training");
+  SmoothNetTrainConfig config = defaultSmoothNetTrainConfig();
+  config.epochs = positiveInt(a, "epochs", config.epochs);
+  config.threads = positiveInt(a, "threads", config.threads);
+  config.batch_pairs = positiveInt(a, "batch", config.batch_pairs);
+  config.steps_per_epoch =
+      static_cast<size_t>(positiveInt(a, "steps", static_cast<int>(config.steps_per_epoch)));
+  config.net.descriptor_dim = positiveInt(a, "words", config.net.descriptor_dim);
+  config.net.smoothnet_keypoints = positiveInt(a, "keypoints", config.net.smoothnet_keypoints);
+  if (a.has("lr")) config.learning_rate = a.getNumber("lr");
+  if (a.has("seed")) config.seed = a.getCount("seed");
+  validateNetConfig(config.net);  // before the long extraction, not after it
+  return config;
+}
+
+// 3dsmoothnet: keypoint pairs and then the visual words (learn/smoothnet_trainer.h); the model
+// is written once, when its words are fitted.
+int runTrainSmoothNet(const CliArgs& a) {
+  const SmoothNetTrainConfig config = smoothNetTrainConfig(a);
+  const TrainingSet data = trainingData(a);
+  if (data.interrupted) return interruptedWork("train", "while extracting the training data", "");
+  EpochProgress progress(config.epochs, false, true);
+  std::vector<EpochStats> history;
+  const TrainCallbacks callbacks = epochCallbacks(a, progress, history);
+  const SmoothNetTrainResult result = trainSmoothNet(data, config, callbacks);
+  const TrainResult& training = result.training;
+  if (training.net == nullptr) return interruptedWork("train", "in the first epoch", "");
+  saveNet(a.get("out"), *training.net);
+  std::printf("fitted %d visual words to %zu keypoint descriptors in %.0f s\n",
+              config.net.descriptor_dim, result.word_keypoints, result.word_seconds);
+  std::printf("segment retrieval on the validation objects: top1 %.3f top5 %.3f (%zu queries)\n",
+              result.segments.top1, result.segments.top5, result.segments.queries);
+  TrainConfig shown;
+  shown.net = config.net;
+  shown.epochs = config.epochs;
+  return trainEnd(a, shown, training);
+}
+
+int runTrain(const CliArgs& a) {
+  if (parseDescriptorKind(a.get("descriptor")) == DescriptorKind::kSmoothNetBow)
+    return runTrainSmoothNet(a);
+  for (const char* option : kOnlyForSmoothNet)
+    if (a.has(option)) throw UsageError(std::string("--") + option + ": only for 3dsmoothnet");
+  const TrainConfig config = trainConfig(a);
+  const auto teacher = loadTeacher(a, config);
+  const std::filesystem::path out = a.get("out");
+  const TrainingSet data = trainingData(a);
+  if (data.interrupted) return interruptedWork("train", "while extracting the training data", "");
+  EpochProgress progress(config.epochs, teacher != nullptr);
+  std::vector<EpochStats> history;
+  TrainCallbacks callbacks = epochCallbacks(a, progress, history);
   callbacks.best = [&](DescriptorNetImpl& net) { saveNet(out, net); };
   const TrainResult result = trainDescriptor(data, config, callbacks, teacher);
   return trainEnd(a, config, result);
@@ -273,6 +353,7 @@ int runTrain(const CliArgs& a) {
 const CommandSpec& trainCommand() {
   const TrainConfig net = defaultTrainConfig(DescriptorKind::kSemSegMapNet);
   const TrainConfig cnn = defaultTrainConfig(DescriptorKind::kSegMapCnn);
+  const SmoothNetTrainConfig smooth = defaultSmoothNetTrainConfig();
   // The library's defaults as the help shows them: one value, or one per descriptor.
   auto shown = [&](auto field) {
     std::ostringstream s;
@@ -281,20 +362,29 @@ const CommandSpec& trainCommand() {
     s << ")";
     return s.str();
   };
+  // ... and with 3dsmoothnet's, for the options its training shares.
+  auto shownAll = [&](auto field, auto smooth_value) {
+    std::string text = shown(field);
+    std::ostringstream s;
+    s << "; " << smooth_value << " for 3dsmoothnet)";
+    return text.substr(0, text.size() - 1) + s.str();
+  };
   static const CommandSpec command{
       "train",
       "trains a learned descriptor on simulated ground truth; its best epoch -> --out",
       {
-          {"descriptor", Value::kText, "semsegmap-net|segmap-cnn", "", "the descriptor to train",
-           kRequired},
+          {"descriptor", Value::kText, "semsegmap-net|segmap-cnn|3dsmoothnet", "",
+           "the descriptor to train", kRequired},
           {"dataset", Value::kText, "SPEC[,SPEC...]", "", "the runs to learn from", kRequired},
           {"out", Value::kText, "FILE", "", "the model file to write", kRequired},
           {"epochs", Value::kPositive, "N", "",
-           "epochs " + shown([](const TrainConfig& c) { return c.epochs; })},
+           "epochs " + shownAll([](const TrainConfig& c) { return c.epochs; }, smooth.epochs)},
           {"batch", Value::kPositive, "N", "",
-           "triplets a step " + shown([](const TrainConfig& c) { return c.batch_size; })},
+           "triplets a step (3dsmoothnet: keypoint pairs) " +
+               shownAll([](const TrainConfig& c) { return c.batch_size; }, smooth.batch_pairs)},
           {"threads", Value::kPositive, "N", "",
-           "torch threads " + shown([](const TrainConfig& c) { return c.threads; })},
+           "torch threads " +
+               shownAll([](const TrainConfig& c) { return c.threads; }, smooth.threads)},
           {"config", Value::kText, "FILE", "",
            "pipeline configuration that cuts the runs into segments (default: built-in, as "
            "config/semsegmap.yaml)"},
@@ -306,7 +396,8 @@ const CommandSpec& trainCommand() {
            "anchors drawn per epoch, 0: every observation with a positive " +
                shown([](const TrainConfig& c) { return c.anchors_per_epoch; })},
           {"lr", Value::kNumber, "X", "",
-           "Adam's learning rate " + shown([](const TrainConfig& c) { return c.learning_rate; })},
+           "Adam's learning rate " + shownAll([](const TrainConfig& c) { return c.learning_rate; },
+                                              smooth.learning_rate)},
           {"seed", Value::kCount, "N", "",
            "seed of weights, sampling and augmentation " +
                shown([](const TrainConfig& c) { return c.seed; })},
@@ -348,6 +439,15 @@ const CommandSpec& trainCommand() {
            "points a segment is subsampled to " +
                shown([](const TrainConfig& c) { return c.net.num_points; })},
           {"history", Value::kText, "FILE.csv", "", "also write one row per epoch, after each"},
+          {"words", Value::kPositive, "K", "",
+           "3dsmoothnet: visual words of the bag, k-means centres of keypoint descriptors "
+           "(default: " +
+               std::to_string(smooth.net.descriptor_dim) + ", the paper's best)"},
+          {"keypoints", Value::kPositive, "N", "",
+           "3dsmoothnet: random keypoints a segment is described at (default: " +
+               std::to_string(smooth.net.smoothnet_keypoints) + ")"},
+          {"steps", Value::kPositive, "N", "",
+           "3dsmoothnet: steps an epoch (default: " + std::to_string(smooth.steps_per_epoch) + ")"},
       },
       std::string("--dataset: a key=value after a sim: spec belongs to it, any other item starts a "
                   "new spec\n(';' also separates): sim:world=1,run=S1,sim:world=1,run=S1,"

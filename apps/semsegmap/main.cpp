@@ -4,9 +4,13 @@
 // CMakeLists.txt) is not listed, and asking for it prints one line that says why and exits 1.
 #include <algorithm>
 #include <exception>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
+
+#include <wordexp.h>
 
 #include "cli_args.h"
 #include "eval_args.h"
@@ -130,7 +134,8 @@ std::string overview() {
 #endif
   listed.insert(demo, evalCommands().begin(), evalCommands().end());
   return "usage: semsegmap <command> [options]\n       semsegmap --version\n       semsegmap "
-         "--check-usage <command> [options]   (parses, runs nothing)\n\ncommands:\n" +
+         "--check-usage <command> [options]   (parses, runs nothing)\n       semsegmap "
+         "--check-usage-lines FILE   (the same for each line of FILE)\n\ncommands:\n" +
          commandOverview(listed) + absentNote() + "\n" + kDatasetNotes +
          "\nrun 'semsegmap <command> --help' for a command's options and their defaults.\n";
 }
@@ -293,6 +298,42 @@ int run(const std::vector<std::string>& args, bool check_only) {
   }
 }
 
+// --check-usage for every line of `path` in one process, each line split as a shell would
+// (wordexp: quotes, $VARIABLES; no command substitution). Per line: "--- line N exit C", what it
+// printed, "--- stderr", what it printed there. Tests check every command line of the docs so:
+// the program's start (its libraries loaded) costs about a second each time.
+int checkUsageLines(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    std::cerr << "semsegmap --check-usage-lines: " << path << ": cannot open\n";
+    return 1;
+  }
+  std::string line;
+  int worst = 0;
+  for (size_t n = 1; std::getline(in, line); ++n) {
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    std::ostringstream out, err;
+    int code = 2;
+    wordexp_t words;
+    if (wordexp(line.c_str(), &words, WRDE_NOCMD) != 0) {
+      err << "semsegmap --check-usage-lines: line " << n << " is no command line a shell splits\n";
+    } else {
+      const std::vector<std::string> args(words.we_wordv, words.we_wordv + words.we_wordc);
+      wordfree(&words);
+      std::streambuf* const saved_out = std::cout.rdbuf(out.rdbuf());
+      std::streambuf* const saved_err = std::cerr.rdbuf(err.rdbuf());
+      code = args.empty() ? 2 : run(args, true);
+      std::cout.rdbuf(saved_out);
+      std::cerr.rdbuf(saved_err);
+    }
+    std::cout << "--- line " << n << " exit " << code << "\n"
+              << out.str() << "--- stderr\n"
+              << err.str();
+    worst = std::max(worst, code);
+  }
+  return worst;
+}
+
 }  // namespace
 }  // namespace semsegmap::app
 
@@ -319,6 +360,13 @@ int main(int argc, char** argv) {
       return 2;
     }
     return semsegmap::app::run({args.begin() + 1, args.end()}, true);
+  }
+  if (args[0] == "--check-usage-lines") {
+    if (args.size() != 2) {
+      std::cerr << "semsegmap --check-usage-lines: usage error: one FILE of command lines\n";
+      return 2;
+    }
+    return semsegmap::app::checkUsageLines(args[1]);
   }
   return semsegmap::app::run(args, false);
 }

@@ -48,7 +48,8 @@ void bindFrontEndConfigs(py::module_& m) {
       .field("keep_all_observation_points", &SegmentationConfig::keep_all_observation_points);
 
   StructBinding<DescriptorConfig>(m, "DescriptorConfig", "pipeline/pipeline_config.h")
-      .field("kind", &DescriptorConfig::kind, "eigen | fpfh | segmap-cnn | semsegmap-net")
+      .field("kind", &DescriptorConfig::kind,
+             "eigen | fpfh | segmap-cnn | semsegmap-net | 3dsmoothnet")
       .field("model", &DescriptorConfig::model, "model file of a learned descriptor")
       .field("model_lidar_only", &DescriptorConfig::model_lidar_only,
              "the model taken instead for input with neither colour nor classes")

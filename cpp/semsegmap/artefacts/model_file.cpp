@@ -26,6 +26,10 @@ void putConfig(BinaryWriter& w, const NetConfig& c) {
   w.put(c.sa2_radius);
   w.put(static_cast<uint8_t>(c.use_color));
   w.put(static_cast<uint8_t>(c.use_classes));
+  for (const int32_t f :
+       {c.smoothnet_keypoints, c.smoothnet_voxels, c.smoothnet_local_dim, c.smoothnet_width})
+    w.put(f);
+  w.put(c.smoothnet_radius);
 }
 
 bool getFlag(BinaryReader& r) {
@@ -49,6 +53,15 @@ NetConfig getConfig(BinaryReader& r, DescriptorKind kind, uint32_t version) {
   if (version >= 3) {
     c.use_color = getFlag(r);
     c.use_classes = getFlag(r);
+  }
+  if (version >= 4) {
+    for (int* f :
+         {&c.smoothnet_keypoints, &c.smoothnet_voxels, &c.smoothnet_local_dim, &c.smoothnet_width})
+      *f = r.get<int32_t>("the configuration");
+    c.smoothnet_radius = r.get<float>("the configuration");
+  } else if (kind == DescriptorKind::kSmoothNetBow) {
+    r.fail("corrupt header: a 3dsmoothnet model of format version " + std::to_string(version) +
+           " (3dsmoothnet came with version 4)");
   }
   try {
     validateNetConfig(c);
@@ -175,7 +188,7 @@ std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int thr
 #if SEMSEGMAP_WITH_TORCH
   // Loading the network is the calling thread's first use of torch (learned_describer.h).
   const KeepOpenMpThreads keep;
-  if (kind == DescriptorKind::kSemSegMapNet || kind == DescriptorKind::kSegMapCnn) {
+  if (isLearnedDescriptor(kind)) {
     if (config.model.empty())
       throw std::invalid_argument("descriptor.kind " + config.kind +
                                   " needs a model file (descriptor.model)");

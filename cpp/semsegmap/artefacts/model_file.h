@@ -1,6 +1,9 @@
 // Model files of the learned descriptors. Layout (little-endian, core/binary_io.h):
 //   "SSMNET"  uint32 format version  string kind  int32 x 8 NetConfig fields
 //   [version 2: int32 sa1_divisor, sa2_divisor, sa_neighbours, float32 sa1_radius, sa2_radius]
+//   [version 3: uint8 use_color, use_classes]
+//   [version 4: int32 smoothnet_keypoints, smoothnet_voxels, smoothnet_local_dim,
+//    smoothnet_width, float32 smoothnet_radius (3dsmoothnet, written for every kind)]
 //   char[16] fingerprint  uint64 tensor count, then per parameter and buffer in the module's
 //   order: string name  uint32 rank  int64 x rank sizes  float32 x numel data
 // (string = uint32 length + bytes). The weights are raw tensors rather than torch::save's zip
@@ -22,7 +25,7 @@ namespace semsegmap {
 
 class DescriptorNetImpl;
 
-constexpr uint32_t kModelFormatVersion = 3;
+constexpr uint32_t kModelFormatVersion = 4;
 
 // Written to a temporary name and renamed. Throws std::runtime_error naming the file.
 void writeModelFile(const std::filesystem::path& path, const Model& model);

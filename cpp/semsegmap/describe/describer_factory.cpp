@@ -33,6 +33,7 @@ std::unique_ptr<Describer> makeDescriber(DescriptorKind kind, const DescriberOpt
     }
     case DescriptorKind::kSegMapCnn:
     case DescriptorKind::kSemSegMapNet:
+    case DescriptorKind::kSmoothNetBow:
 #if SEMSEGMAP_WITH_TORCH
       return makeLearnedDescriber(kind, options);
 #else

@@ -1,5 +1,6 @@
 // Segment descriptors (paper section III-C): one interface, batched, for the learned SemSegMap
-// network, the SegMap CNN baseline, and the eigenvalue and FPFH baselines.
+// network, the SegMap CNN baseline, the eigenvalue and FPFH baselines, and 3DSmoothNet's local
+// descriptors as a bag of words (the paper's fourth baseline).
 #pragma once
 
 #include <memory>
@@ -13,11 +14,18 @@
 
 namespace semsegmap {
 
-enum class DescriptorKind { kEigen, kFpfh, kSegMapCnn, kSemSegMapNet };
+enum class DescriptorKind { kEigen, kFpfh, kSegMapCnn, kSemSegMapNet, kSmoothNetBow };
 
-// "eigen", "fpfh", "segmap-cnn", "semsegmap-net"; parse throws std::invalid_argument.
+// "eigen", "fpfh", "segmap-cnn", "semsegmap-net", "3dsmoothnet"; parse throws
+// std::invalid_argument.
 std::string descriptorName(DescriptorKind kind);
 DescriptorKind parseDescriptorKind(const std::string& name);
+
+// The kinds described by a trained network of a model file (describe/learned_net.h).
+inline bool isLearnedDescriptor(DescriptorKind kind) {
+  return kind == DescriptorKind::kSemSegMapNet || kind == DescriptorKind::kSegMapCnn ||
+         kind == DescriptorKind::kSmoothNetBow;
+}
 
 // Why this build cannot describe with `kind`, in one line, or "" when it can: the learned kinds
 // need libtorch (the build option SEMSEGMAP_WITH_TORCH), fpfh needs PCL (SEMSEGMAP_WITH_PCL).

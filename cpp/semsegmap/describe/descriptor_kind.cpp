@@ -15,6 +15,8 @@ std::string descriptorName(DescriptorKind kind) {
       return "segmap-cnn";
     case DescriptorKind::kSemSegMapNet:
       return "semsegmap-net";
+    case DescriptorKind::kSmoothNetBow:
+      return "3dsmoothnet";
   }
   // Only reachable through a cast of an out-of-range integer.
   throw std::invalid_argument("descriptorName: invalid DescriptorKind value " +
@@ -22,12 +24,13 @@ std::string descriptorName(DescriptorKind kind) {
 }
 
 DescriptorKind parseDescriptorKind(const std::string& name) {
-  for (const DescriptorKind kind : {DescriptorKind::kEigen, DescriptorKind::kFpfh,
-                                    DescriptorKind::kSegMapCnn, DescriptorKind::kSemSegMapNet}) {
+  for (const DescriptorKind kind :
+       {DescriptorKind::kEigen, DescriptorKind::kFpfh, DescriptorKind::kSegMapCnn,
+        DescriptorKind::kSemSegMapNet, DescriptorKind::kSmoothNetBow}) {
     if (descriptorName(kind) == name) return kind;
   }
   throw std::invalid_argument("unknown descriptor '" + name +
-                              "' (expected eigen, fpfh, segmap-cnn or semsegmap-net)");
+                              "' (expected eigen, fpfh, segmap-cnn, semsegmap-net or 3dsmoothnet)");
 }
 
 std::string descriptorNotBuilt(DescriptorKind kind) {
@@ -40,6 +43,7 @@ std::string descriptorNotBuilt(DescriptorKind kind) {
                                   "-DSEMSEGMAP_WITH_PCL=ON)";
     case DescriptorKind::kSegMapCnn:
     case DescriptorKind::kSemSegMapNet:
+    case DescriptorKind::kSmoothNetBow:
       return SEMSEGMAP_WITH_TORCH ? ""
                                   : "this build has no learned descriptors (built without "
                                     "libtorch, reconfigure with -DSEMSEGMAP_WITH_TORCH=ON)";

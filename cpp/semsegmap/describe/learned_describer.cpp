@@ -55,7 +55,7 @@ class LearnedDescriber : public Describer {
         threads_(options.threads > 0
                      ? options.threads
                      : std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {
-    if (kind != DescriptorKind::kSemSegMapNet && kind != DescriptorKind::kSegMapCnn) {
+    if (!isLearnedDescriptor(kind)) {
       throw std::invalid_argument("makeLearnedDescriber: " + descriptorName(kind) +
                                   " is not a learned descriptor");
     }

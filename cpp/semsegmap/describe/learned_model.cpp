@@ -54,6 +54,12 @@ uint64_t mixConfig(const NetConfig& c, uint64_t h) {
     const uint8_t flags[] = {c.use_color, c.use_classes};
     h = fnv1a64(flags, sizeof flags, h);
   }
+  if (c.kind == DescriptorKind::kSmoothNetBow) {
+    const int32_t v[] = {c.smoothnet_keypoints, c.smoothnet_voxels, c.smoothnet_local_dim,
+                         c.smoothnet_width};
+    h = fnv1a64(v, sizeof v, h);
+    h = fnv1a64(&c.smoothnet_radius, sizeof c.smoothnet_radius, h);
+  }
   return h;
 }
 

@@ -9,6 +9,8 @@
 #include "semsegmap/describe/net_input.h"
 #include "semsegmap/describe/segmap_cnn.h"
 #include "semsegmap/describe/semsegmap_net.h"
+#include "semsegmap/describe/smoothnet.h"
+#include "semsegmap/describe/smoothnet_input.h"
 
 namespace semsegmap {
 
@@ -61,6 +63,15 @@ NetInput makeNetInput(const NetConfig& config, const std::vector<const EnrichedC
         copyInto(in.target_occupancy, i, s.occupancy);
       }
     });
+  } else if (config.kind == DescriptorKind::kSmoothNetBow) {
+    const int64_t k = config.smoothnet_keypoints, g = config.smoothnet_voxels;
+    in.sdv = torch::empty({b * k, 1, g, g, g});
+    at::parallel_for(0, b, 1, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i)
+        copyInto(in.sdv, i,
+                 smoothNetSample(*segments[i], config.smoothnet_keypoints, config.smoothnet_radius,
+                                 config.smoothnet_voxels, salts[i]));
+    });
   } else {
     in.occupancy = torch::empty({b, 1, config.grid_xy, config.grid_xy, config.grid_z});
     in.scale = torch::empty({b, 3});
@@ -81,6 +92,7 @@ std::shared_ptr<DescriptorNetImpl> makeNet(const NetConfig& config) {
   if (config.kind == DescriptorKind::kSemSegMapNet) {
     return std::make_shared<SemSegMapNetImpl>(config);
   }
+  if (config.kind == DescriptorKind::kSmoothNetBow) return std::make_shared<SmoothNetImpl>(config);
   return std::make_shared<SegMapCnnImpl>(config);
 }
 

@@ -2,7 +2,9 @@
 // (learn/): `semsegmap-net` (PointNet++ on the coloured points + a small 3D CNN on a 3x3x3 grid
 // of class histograms + the normalisation scale) and `segmap-cnn` (SegMap's CNN on a 32x32x16
 // occupancy grid aligned by 2-D PCA yaw). Both also decode a voxel grid from the descriptor
-// (reconstruction loss), and are trained with the same triplet loss.
+// (reconstruction loss), and are trained with the same triplet loss. `3dsmoothnet`
+// (smoothnet.h) describes keypoints and bags them into words; it is trained on corresponding
+// points instead (learn/smoothnet_trainer.h).
 #pragma once
 
 #include <torch/torch.h>
@@ -27,6 +29,7 @@ struct NetInput {
   torch::Tensor occupancy;         // segmap-cnn input: [B, 1, grid_xy, grid_xy, grid_z]
   torch::Tensor target_occupancy;  // decoder target, [B, 1, D, D, D] (or the cnn's own grid)
   torch::Tensor n_points;          // [B] float: points in each segment before subsampling
+  torch::Tensor sdv;               // 3dsmoothnet: [B * smoothnet_keypoints, 1, G, G, G] SDV grids
 };
 
 struct NetOutput {

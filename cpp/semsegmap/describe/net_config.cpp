@@ -24,17 +24,26 @@ void requireMultiple(const char* field, int value, int of) {
   }
 }
 
-bool isLearned(DescriptorKind kind) {
-  return kind == DescriptorKind::kSemSegMapNet || kind == DescriptorKind::kSegMapCnn;
+void validateSmoothNet(const NetConfig& config) {
+  requireRange("smoothnet_keypoints", config.smoothnet_keypoints, 1, 1024);
+  // The network halves the grid twice and then covers it with one kernel.
+  requireRange("smoothnet_voxels", config.smoothnet_voxels, 8, 64);
+  requireMultiple("smoothnet_voxels", config.smoothnet_voxels, 4);
+  requireRange("smoothnet_local_dim", config.smoothnet_local_dim, 2, 1024);
+  requireRange("smoothnet_width", config.smoothnet_width, 1, 256);
+  requireRange("descriptor_dim (visual words)", config.descriptor_dim, 2, 1024);
+  if (!(config.smoothnet_radius > 0.0f && config.smoothnet_radius < 100.0f))
+    throw std::invalid_argument("NetConfig.smoothnet_radius: expected 0 < radius < 100 m");
 }
 
 }  // namespace
 
 void validateNetConfig(const NetConfig& config) {
-  if (!isLearned(config.kind)) {
+  if (!isLearnedDescriptor(config.kind)) {
     throw std::invalid_argument("NetConfig.kind = " + descriptorName(config.kind) +
-                                ": expected segmap-cnn or semsegmap-net");
+                                ": expected segmap-cnn, semsegmap-net or 3dsmoothnet");
   }
+  if (config.kind == DescriptorKind::kSmoothNetBow) validateSmoothNet(config);
   requireRange("descriptor_dim", config.descriptor_dim, 1, 1024);
   // Set abstraction takes num_points / 4 and / 16 centres (the paper: 2048 points).
   requireRange("num_points", config.num_points, 64, 16384);
@@ -127,12 +136,31 @@ Shapes segmapCnnShapes(const NetConfig& c) {
   return out;
 }
 
+Shapes smoothNetShapes(const NetConfig& c) {
+  const int64_t w = c.smoothnet_width, g = c.smoothnet_voxels / 4;
+  Shapes out;
+  addLayer(out, "cnn.0", {w, 1, 3, 3, 3});
+  addLayer(out, "cnn.1", {2 * w, w, 3, 3, 3});
+  addLayer(out, "cnn.2", {2 * w, 2 * w, 3, 3, 3});
+  addLayer(out, "cnn.3", {4 * w, 2 * w, 3, 3, 3});
+  addLayer(out, "cnn.4", {4 * w, 4 * w, g, g, g});
+  addLayer(out, "local", {c.smoothnet_local_dim, 4 * w});
+  out.push_back({"words", {c.descriptor_dim, c.smoothnet_local_dim}});  // a buffer, not trained
+  return out;
+}
+
 }  // namespace
 
 std::vector<TensorShape> netTensorShapes(const NetConfig& config) {
   validateNetConfig(config);
-  return config.kind == DescriptorKind::kSemSegMapNet ? semsegmapNetShapes(config)
-                                                      : segmapCnnShapes(config);
+  switch (config.kind) {
+    case DescriptorKind::kSemSegMapNet:
+      return semsegmapNetShapes(config);
+    case DescriptorKind::kSmoothNetBow:
+      return smoothNetShapes(config);
+    default:
+      return segmapCnnShapes(config);
+  }
 }
 
 }  // namespace semsegmap

@@ -35,6 +35,13 @@ struct NetConfig {
   // input from data that has them. Model files before format version 3 used both.
   bool use_color = true;
   bool use_classes = true;
+  // 3dsmoothnet (describe/smoothnet.h): descriptor_dim is its number of visual words. Model
+  // files before format version 4 hold no such model.
+  int smoothnet_keypoints = 32;   // random keypoints a segment is described at
+  float smoothnet_radius = 1.0f;  // metres: the local frame's support, half the grid's side
+  int smoothnet_voxels = 16;      // the SDV grid's cells a side (the paper's 16)
+  int smoothnet_local_dim = 32;   // a keypoint's descriptor (the paper's 32)
+  int smoothnet_width = 8;        // channels of the first convolution
 };
 
 // Throws std::invalid_argument naming the field when a value is out of range (e.g. a grid size
