@@ -54,6 +54,7 @@ EnrichedCloud enriched(const std::vector<Eigen::Vector3f>& points) {
   return out;
 }
 
+#if SEMSEGMAP_WITH_TORCH
 NetConfig tinySmoothNet() {
   NetConfig c;
   c.kind = DescriptorKind::kSmoothNetBow;
@@ -64,6 +65,7 @@ NetConfig tinySmoothNet() {
   c.smoothnet_local_dim = 8;
   return c;
 }
+#endif
 
 }  // namespace
 
