@@ -250,6 +250,39 @@ const Result& help(const std::string& command) {
   return it->second;
 }
 
+// `semsegmap --check-usage-lines` on `lines`: each line parsed as its command would, all in one
+// process (a start of the binary costs about a second), one Result per line ("--- line N exit
+// C", its output, "--- stderr", its errors).
+std::vector<Result> checkUsageLines(const std::vector<std::string>& lines) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() /
+      ("semsegmap_lines_" + std::to_string(::getpid()) + "_" +
+       std::to_string(std::hash<std::string>{}(lines.empty() ? "" : lines.front())) + ".txt");
+  {
+    std::ofstream out(file);
+    for (const std::string& line : lines) out << line << "\n";
+  }
+  const Result all = run("--check-usage-lines '" + file.string() + "'");
+  std::filesystem::remove(file);
+  std::vector<Result> results;
+  std::istringstream printed(all.out);
+  bool in_err = false;
+  for (std::string line; std::getline(printed, line);) {
+    int number = 0, code = 0;
+    if (std::sscanf(line.c_str(), "--- line %d exit %d", &number, &code) == 2) {
+      results.push_back({code, "", ""});
+      in_err = false;
+    } else if (line == "--- stderr") {
+      in_err = true;
+    } else if (!results.empty()) {
+      (in_err ? results.back().err : results.back().out) += line + "\n";
+    }
+  }
+  EXPECT_EQ(results.size(), lines.size()) << all.out << all.err;
+  results.resize(lines.size());
+  return results;
+}
+
 bool lists(const std::string& help, const std::string& option) {
   for (const auto& [name, placeholder] : helpOptions(help))
     if (name == option) return true;
@@ -392,8 +425,8 @@ TEST(Cli, HelpSaysEachDefaultOnce) {
 // Every option a help lists is accepted by the parser: given all of them (a value each) and then
 // an unknown one, the only complaint is about the unknown one.
 TEST(Cli, ParserAcceptsWhatTheHelpLists) {
+  std::vector<std::string> lines;
   for (const CommandOptions& c : kCommands) {
-    SCOPED_TRACE(c.command);
     std::string args = c.command;
     for (const auto& [name, placeholder] : helpOptions(help(c.command).out)) {
       if (name == "help") continue;
@@ -404,9 +437,15 @@ TEST(Cli, ParserAcceptsWhatTheHelpLists) {
       else if (!placeholder.empty())
         args += " 1";
     }
-    const Result r = run(args + " --not-an-option");
-    EXPECT_EQ(r.code, 2) << r.err;
-    EXPECT_NE(r.err.find("unknown option --not-an-option"), std::string::npos) << r.err;
+    lines.push_back(args + " --not-an-option");
+  }
+  // Parsed as each command would, in one process (the parse is the same with --check-usage).
+  const std::vector<Result> results = checkUsageLines(lines);
+  for (size_t i = 0; i < kCommands.size(); ++i) {
+    SCOPED_TRACE(kCommands[i].command);
+    EXPECT_EQ(results[i].code, 2) << results[i].err;
+    EXPECT_NE(results[i].err.find("unknown option --not-an-option"), std::string::npos)
+        << results[i].err;
   }
 }
 
@@ -517,15 +556,20 @@ TEST(Cli, UnknownNamesSuggestTheNearestKnownOne) {
 }
 
 TEST(Cli, NegativeMaxFramesIsAUsageErrorEverywhere) {
+  std::vector<std::string> commands, lines;
   for (const CommandOptions& c : kCommands) {
     if (std::find(c.options.begin(), c.options.end(), "max-frames") == c.options.end()) continue;
-    SCOPED_TRACE(c.command);
-    const Result r = run(c.command + " --max-frames=-1");
-    EXPECT_EQ(r.code, 2) << r.err;
-    EXPECT_EQ(r.err, "semsegmap " + c.command +
-                         ": usage error: option --max-frames must not be negative, got '-1'\n"
-                         "run 'semsegmap " +
-                         c.command + " --help' for its options\n");
+    commands.push_back(c.command);
+    lines.push_back(c.command + " --max-frames=-1");
+  }
+  const std::vector<Result> results = checkUsageLines(lines);  // one process, parsed alike
+  for (size_t i = 0; i < commands.size(); ++i) {
+    SCOPED_TRACE(commands[i]);
+    EXPECT_EQ(results[i].code, 2) << results[i].err;
+    EXPECT_EQ(results[i].err, "semsegmap " + commands[i] +
+                                  ": usage error: option --max-frames must not be negative, got "
+                                  "'-1'\nrun 'semsegmap " +
+                                  commands[i] + " --help' for its options\n");
   }
   const Result spaced = run("map --dataset d --config c --out o --max-frames -1");
   EXPECT_EQ(spaced.code, 2);
@@ -2182,29 +2226,9 @@ std::vector<DocumentedCommand> documentedCommands() {
 TEST(Docs, EveryCommandLineTheDocumentationShowsParses) {
   const std::vector<DocumentedCommand> commands = documentedCommands();
   ASSERT_GE(commands.size(), 40u) << "the README and docs show that many";
-  TempDir tmp;
-  const std::filesystem::path lines = tmp.path() / "lines.txt";
-  {
-    std::ofstream out(lines);
-    for (const DocumentedCommand& c : commands) out << expanded(c.line, c.variables) << "\n";
-  }
-  const Result all = run("--check-usage-lines '" + lines.string() + "'");
-  // Per line: "--- line N exit C", its output, "--- stderr", its errors.
-  std::vector<Result> results;
-  std::istringstream printed(all.out);
-  bool in_err = false;
-  for (std::string line; std::getline(printed, line);) {
-    int number = 0, code = 0;
-    if (std::sscanf(line.c_str(), "--- line %d exit %d", &number, &code) == 2) {
-      results.push_back({code, "", ""});
-      in_err = false;
-    } else if (line == "--- stderr") {
-      in_err = true;
-    } else if (!results.empty()) {
-      (in_err ? results.back().err : results.back().out) += line + "\n";
-    }
-  }
-  ASSERT_EQ(results.size(), commands.size()) << all.out << all.err;
+  std::vector<std::string> lines;
+  for (const DocumentedCommand& c : commands) lines.push_back(expanded(c.line, c.variables));
+  const std::vector<Result> results = checkUsageLines(lines);
   size_t checked = 0;
   for (size_t i = 0; i < commands.size(); ++i) {
     const DocumentedCommand& c = commands[i];

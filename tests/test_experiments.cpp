@@ -134,7 +134,7 @@ TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
 
   DescriptorExperimentConfig dc;
   dc.preset = "tiny";
-  dc.max_frames = 80;
+  dc.max_frames = 50;
   dc.segmentation = bothConfigs()[0];
   dc.models = kSource + "/models";
   dc.descriptors = {"semsegmap-net", "eigen"};
@@ -152,7 +152,7 @@ TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
 
   LocalizationExperimentConfig lc;
   lc.preset = "tiny";
-  lc.max_frames = 60;
+  lc.max_frames = 30;
   lc.configs = bothConfigs();
   const LocalizationExperiment l = runLocalizationExperiment(lc, out);
   const YAML::Node lj = YAML::LoadFile((out / "localization.json").string());
@@ -164,7 +164,7 @@ TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
           "mean_rotation_error_deg", "n_wrong", "wrong_rate", "recall_along_trajectory", "fps",
           "map_segments", "map_bytes"})
       EXPECT_TRUE(r[key].IsDefined()) << key;
-    EXPECT_EQ(r["frames"].as<size_t>(), 60u);
+    EXPECT_EQ(r["frames"].as<size_t>(), 30u);
     EXPECT_GT(r["map_segments"].as<size_t>(), 0u);
     EXPECT_GT(r["fps"].as<double>(), 0.0);
     const size_t n = r["n_localizations"].as<size_t>();
@@ -174,7 +174,7 @@ TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
     EXPECT_TRUE(std::filesystem::exists(out / dir / "localizations.csv"));
     EXPECT_TRUE(std::filesystem::exists(out / dir / "summary.json"));
   }
-  // S2 drives where S0 drove: SemSegMap localizes there within its first 60 frames.
+  // S2 drives where S0 drove: SemSegMap localizes there within its first 30 frames.
   EXPECT_GT(l.results[0].summary.localizations, 0u);
   EXPECT_TRUE(std::filesystem::exists(out / "maps" / "semsegmap.map"));
   expectPng(out / "localization_accuracy.png");

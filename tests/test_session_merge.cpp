@@ -56,8 +56,8 @@ const Pose kOffset =
 
 TEST(SessionMerge, ADriftingSessionJoinsTheMapAtItsTruePlace) {
   SEMSEGMAP_SKIP_WITHOUT_SIM();
-  const auto map = mapOf("sim:world=1,run=S0,preset=tiny,frames=200");
-  const std::string spec = "sim:world=1,run=S0,preset=tiny,frames=200,traffic=7";
+  const auto map = mapOf("sim:world=1,run=S0,preset=tiny,frames=130");
+  const std::string spec = "sim:world=1,run=S0,preset=tiny,frames=130,traffic=7";
   OffsetOdometry source(openDataset(spec), kOffset);
   const MergedSession m =
       runSessionMerge(source, config(), map, std::make_shared<OracleDescriber>(), spec, 1796000000);
@@ -70,7 +70,7 @@ TEST(SessionMerge, ADriftingSessionJoinsTheMapAtItsTruePlace) {
   const MapSession& s = m.map.sessions[1];
   EXPECT_EQ(s.name, spec);
   EXPECT_EQ(s.merged_unix_s, 1796000000);
-  ASSERT_EQ(s.trajectory.size(), 200u);
+  ASSERT_EQ(s.trajectory.size(), 130u);
   auto truth = openDataset(spec);
   double error = 0.0, odometry_error = 0.0;
   for (size_t k = 0; k < s.trajectory.size(); ++k) {
@@ -123,8 +123,8 @@ TEST(SessionMerge, ADriftingSessionJoinsTheMapAtItsTruePlace) {
   saveTargetMap(path, m.map);
   const auto back = std::make_shared<const TargetMap>(loadTargetMap(path));
   ASSERT_EQ(back->sessions.size(), 2u);
-  EXPECT_EQ(back->sessions[1].trajectory.size(), 200u);
-  const std::string third = "sim:world=1,run=S3,preset=tiny,frames=80";
+  EXPECT_EQ(back->sessions[1].trajectory.size(), 130u);
+  const std::string third = "sim:world=1,run=S3,preset=tiny,frames=60";
   auto source3 = openDataset(third);
   const MergedSession m3 = runSessionMerge(*source3, config(), back,
                                            std::make_shared<OracleDescriber>(), third, 1796000001);
