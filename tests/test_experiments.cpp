@@ -252,7 +252,7 @@ TEST(FleetExperiment, TwoDrivesMergeWhereTheTruthIsAndAThirdLocalizesInTheWorld)
   SEMSEGMAP_SKIP_WITHOUT_TORCH();
   FleetExperimentConfig c;
   c.preset = "tiny";
-  c.max_frames = 80;
+  c.max_frames = 60;
   c.sessions = {"S0", "S0,traffic=7"};
   c.queries = {"S0,traffic=3"};
   c.config = std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semsegmap.yaml";
