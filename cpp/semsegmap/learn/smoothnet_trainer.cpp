@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "semsegmap/describe/smoothnet_input.h"
+#include "semsegmap/learn/training_state.h"
 
 namespace semsegmap {
 
@@ -41,10 +42,11 @@ std::vector<Eigen::Vector3f> positionsOf(const TrainingObservation& o) {
   return out;
 }
 
-// One keypoint of an observation and its counterpart in another observation of the same object.
+// One keypoint of an observation and its counterpart in another observation of the same object,
+// with the points of both (map frame), which their grids are made of.
 struct KeypointPair {
-  size_t anchor = 0, positive = 0;                                           // observations
-  Eigen::Vector3f a = Eigen::Vector3f::Zero(), p = Eigen::Vector3f::Zero();  // map frame
+  Eigen::Vector3f a = Eigen::Vector3f::Zero(), p = Eigen::Vector3f::Zero();
+  std::vector<Eigen::Vector3f> anchor_points, positive_points;
   uint64_t object = 0;
 };
 
@@ -64,19 +66,21 @@ class PairMaker {
   std::optional<KeypointPair> make(std::mt19937& rng) const {
     for (int attempt = 0; attempt < 8; ++attempt) {
       const auto& anchors = sampler_.anchors();
+      const size_t anchor =
+          anchors[std::uniform_int_distribution<size_t>(0, anchors.size() - 1)(rng)];
+      size_t positive = sampler_.positive(anchor, rng);
+      for (int other = 0; other < 4 && sameSegment(anchor, positive); ++other)
+        positive = sampler_.positive(anchor, rng);
       KeypointPair pair;
-      pair.anchor = anchors[std::uniform_int_distribution<size_t>(0, anchors.size() - 1)(rng)];
-      pair.positive = sampler_.positive(pair.anchor, rng);
-      for (int other = 0; other < 4 && sameSegment(pair.anchor, pair.positive); ++other)
-        pair.positive = sampler_.positive(pair.anchor, rng);
-      const std::vector<Eigen::Vector3f> a = positionsOf(data_.observations[pair.anchor]);
-      const std::vector<Eigen::Vector3f> p = positionsOf(data_.observations[pair.positive]);
+      pair.anchor_points = positionsOf(data_.observations[anchor]);
+      pair.positive_points = positionsOf(data_.observations[positive]);
+      const auto& a = pair.anchor_points;
       pair.a = a[std::uniform_int_distribution<size_t>(0, a.size() - 1)(rng)];
       float best = std::numeric_limits<float>::infinity();
-      for (const Eigen::Vector3f& q : p)
+      for (const Eigen::Vector3f& q : pair.positive_points)
         if ((q - pair.a).squaredNorm() < best) best = (q - pair.a).squaredNorm(), pair.p = q;
       if (best > config_.correspondence_m * config_.correspondence_m) continue;
-      pair.object = keys_[pair.anchor];
+      pair.object = keys_[anchor];
       return pair;
     }
     return std::nullopt;
@@ -97,23 +101,22 @@ class PairMaker {
 std::vector<KeypointPair> makePairs(const PairMaker& maker, size_t count, std::mt19937& rng) {
   std::vector<KeypointPair> pairs;
   for (size_t tries = 0; pairs.size() < count && tries < 20 * count; ++tries)
-    if (std::optional<KeypointPair> pair = maker.make(rng)) pairs.push_back(*pair);
+    if (std::optional<KeypointPair> pair = maker.make(rng)) pairs.push_back(std::move(*pair));
   return pairs;
 }
 
 // The SDV grids of the pairs' anchors and positives, [N, 1, G, G, G] each.
-std::pair<torch::Tensor, torch::Tensor> pairGrids(const TrainingSet& data,
-                                                  const std::vector<KeypointPair>& pairs,
+std::pair<torch::Tensor, torch::Tensor> pairGrids(const std::vector<KeypointPair>& pairs,
                                                   const NetConfig& c) {
   const int64_t n = static_cast<int64_t>(pairs.size()), g = c.smoothnet_voxels;
   torch::Tensor a = torch::empty({n, 1, g, g, g}), p = torch::empty({n, 1, g, g, g});
   at::parallel_for(0, n, 1, [&](int64_t begin, int64_t end) {
     for (int64_t i = begin; i < end; ++i) {
       const KeypointPair& pair = pairs[static_cast<size_t>(i)];
-      for (const auto& [out, obs, at] :
-           {std::tuple(&a, pair.anchor, pair.a), std::tuple(&p, pair.positive, pair.p)}) {
-        const std::vector<float> grid = keypointGrid(positionsOf(data.observations[obs]), at,
-                                                     c.smoothnet_radius, c.smoothnet_voxels);
+      for (const auto& [out, points, at] : {std::tuple(&a, &pair.anchor_points, pair.a),
+                                            std::tuple(&p, &pair.positive_points, pair.p)}) {
+        const std::vector<float> grid =
+            keypointGrid(*points, at, c.smoothnet_radius, c.smoothnet_voxels);
         std::copy(grid.begin(), grid.end(), out->data_ptr<float>() + i * g * g * g);
       }
     }
@@ -161,19 +164,6 @@ RetrievalAccuracy keypointRetrieval(SmoothNetImpl& net, const torch::Tensor& a,
   if (was_training) net.train();
   return out;
 }
-
-struct WeightSnapshot {
-  std::vector<torch::Tensor> tensors;
-  void take(SmoothNetImpl& net) {
-    tensors.clear();
-    for (const auto& t : net.parameters()) tensors.push_back(t.detach().clone());
-  }
-  void restore(SmoothNetImpl& net) const {
-    torch::NoGradGuard no_grad;
-    size_t k = 0;
-    for (auto& t : net.parameters()) t.copy_(tensors.at(k++));
-  }
-};
 
 }  // namespace
 
@@ -225,9 +215,9 @@ std::vector<size_t> wordSample(const std::vector<size_t>& train, size_t count, u
   return out;
 }
 
-EpochStats runEpoch(SmoothNetImpl& net, torch::optim::Adam& optimizer, const TrainingSet& data,
-                    const PairMaker& maker, const SmoothNetTrainConfig& config, int epoch,
-                    std::mt19937& rng, const TrainCallbacks& callbacks, bool* stopped) {
+EpochStats runEpoch(SmoothNetImpl& net, torch::optim::Adam& optimizer, const PairMaker& maker,
+                    const SmoothNetTrainConfig& config, int epoch, std::mt19937& rng,
+                    const TrainCallbacks& callbacks, bool* stopped) {
   const auto t0 = Clock::now();
   double sum = 0.0;
   for (size_t step = 0; step < config.steps_per_epoch; ++step) {
@@ -238,7 +228,7 @@ EpochStats runEpoch(SmoothNetImpl& net, torch::optim::Adam& optimizer, const Tra
     const std::vector<KeypointPair> pairs =
         makePairs(maker, static_cast<size_t>(config.batch_pairs), rng);
     if (pairs.size() < 2) throw std::runtime_error("3dsmoothnet: no corresponding keypoints");
-    const auto [a, p] = pairGrids(data, pairs, config.net);
+    const auto [a, p] = pairGrids(pairs, config.net);
     const torch::Tensor loss = keypointLoss(net.local(a), net.local(p), pairs, config.temperature,
                                             config.net.smoothnet_radius);
     optimizer.zero_grad();
@@ -260,11 +250,7 @@ EpochStats runEpoch(SmoothNetImpl& net, torch::optim::Adam& optimizer, const Tra
 SmoothNetTrainResult trainSmoothNet(const TrainingSet& data, const SmoothNetTrainConfig& config,
                                     const TrainCallbacks& callbacks) {
   checkSmoothNetConfig(config);
-  struct TorchThreads {
-    int saved = torch::get_num_threads();
-    explicit TorchThreads(int threads) { torch::set_num_threads(threads); }
-    ~TorchThreads() { torch::set_num_threads(saved); }
-  } threads(config.threads);
+  const TorchThreadCount threads(config.threads);
   torch::manual_seed(config.seed);
   std::mt19937 rng(static_cast<uint32_t>(config.seed));
 
@@ -279,12 +265,14 @@ SmoothNetTrainResult trainSmoothNet(const TrainingSet& data, const SmoothNetTrai
   if (train_pairs.empty())
     throw std::runtime_error(
         "training data has no instance observed twice: nothing to learn from (more frames?)");
-  std::mt19937 validation_rng(static_cast<uint32_t>(config.seed + 1));
-  const std::vector<KeypointPair> fixed =
-      validation_pairs.empty()
-          ? std::vector<KeypointPair>{}
-          : makePairs(validation_pairs, config.validation_pairs, validation_rng);
-  const auto [val_a, val_p] = pairGrids(data, fixed, config.net);
+  // The fixed validation pairs' grids, made once (their points are let go).
+  const auto [val_a, val_p] = [&] {
+    std::mt19937 validation_rng(static_cast<uint32_t>(config.seed + 1));
+    return pairGrids(validation_pairs.empty()
+                         ? std::vector<KeypointPair>{}
+                         : makePairs(validation_pairs, config.validation_pairs, validation_rng),
+                     config.net);
+  }();
 
   auto net = std::make_shared<SmoothNetImpl>(config.net);
   net->train();
@@ -294,12 +282,12 @@ SmoothNetTrainResult trainSmoothNet(const TrainingSet& data, const SmoothNetTrai
   for (int epoch = 1; epoch <= config.epochs; ++epoch) {
     bool stopped = false;
     EpochStats stats =
-        runEpoch(*net, optimizer, data, train_pairs, config, epoch, rng, callbacks, &stopped);
+        runEpoch(*net, optimizer, train_pairs, config, epoch, rng, callbacks, &stopped);
     if (stopped) {
       training.interrupted = true;
       break;
     }
-    if (!fixed.empty()) stats.validation = keypointRetrieval(*net, val_a, val_p);
+    if (val_a.size(0) > 0) stats.validation = keypointRetrieval(*net, val_a, val_p);
     const double score = stats.validation.queries > 0 ? stats.validation.top1 : -stats.loss;
     if (score > best_score) {
       best_score = score;

@@ -9,6 +9,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "semsegmap/learn/training_state.h"
+
 namespace semsegmap {
 
 namespace {
@@ -72,23 +74,6 @@ void copyWeights(DescriptorNetImpl& from, DescriptorNetImpl& to) {
     target[i].second.copy_(source[i].second);
   }
 }
-
-// Copies of the weights of the best epoch, so that the result does not depend on a file.
-struct Snapshot {
-  std::vector<torch::Tensor> tensors;
-  void take(DescriptorNetImpl& net) {
-    tensors.clear();
-    for (const auto& t : net.parameters()) tensors.push_back(t.detach().clone());
-    for (const auto& t : net.buffers()) tensors.push_back(t.detach().clone());
-  }
-  void restore(DescriptorNetImpl& net) const {
-    if (tensors.empty()) return;
-    torch::NoGradGuard no_grad;
-    size_t k = 0;
-    for (auto& t : net.parameters()) t.copy_(tensors[k++]);
-    for (auto& t : net.buffers()) t.copy_(tensors[k++]);
-  }
-};
 
 struct Mean {
   double sum = 0.0;
@@ -421,12 +406,7 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
                             std::shared_ptr<DescriptorNetImpl> teacher) {
   checkConfig(config);
   if (teacher) checkTeacher(config, *teacher);
-  // libtorch's thread count is the process's: given back when training ends, however it ends.
-  struct TorchThreads {
-    int saved = torch::get_num_threads();
-    explicit TorchThreads(int threads) { torch::set_num_threads(threads); }
-    ~TorchThreads() { torch::set_num_threads(saved); }
-  } threads(config.threads);
+  const TorchThreadCount threads(config.threads);
   torch::manual_seed(config.seed);
 
   TrainResult result;
@@ -440,7 +420,7 @@ TrainResult trainDescriptor(const TrainingSet& data, const TrainConfig& config,
         "training data has no instance observed twice: nothing to learn from (more frames?)");
 
   Training training(data, config, split, sampler, std::move(teacher));
-  Snapshot best;
+  WeightSnapshot best;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int epoch = 1; epoch <= config.epochs; ++epoch) {
     std::optional<EpochStats> done = training.epoch(epoch, callbacks);
