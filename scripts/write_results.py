@@ -18,6 +18,8 @@ renamed, so an interrupted run leaves the old one whole. KIND says what the inpu
                 and the network's share of the cores, a row per way of labelling
   segmentation  segmentation.json of `eval segmentation|paper`
   descriptors   descriptors.json of `eval descriptors|paper`
+  completeness  descriptors.json of `eval descriptors|paper`: the run-time completeness
+                estimate's agreement, retrieval per estimated band and on one-scan wake-ups
   benchmarks    Google Benchmark JSON (`semsegmap_bench --benchmark_out=FILE`)
   memory        LABEL=rss.csv of `semsegmap_memory_run`: the resident set per kilometre
   segments      LABEL=segments.csv of `semsegmap segment`: count, size and purity
@@ -252,6 +254,54 @@ def descriptors_table(inputs):
     header = ([("descriptor", 0), ("top-1", 1), ("top-16", 1)] +
               [(f"top-16 {band}", 1) for band in bands] + [("segments/s", 1)])
     return table(header, rows)
+
+
+def top16(curve):
+    # A band's curve holds the share found within k = 1, 2, ...: its 16th entry is top-16.
+    return curve[min(15, len(curve) - 1)] if curve else None
+
+
+def leaders(columns, names):
+    # Per column, the descriptor(s) with the highest value (ties all named).
+    out = []
+    for col in columns:
+        values = [v for v in col if v is not None]
+        if not values:
+            out.append("-")
+            continue
+        best = max(values)
+        out.append(", ".join(f"`{n}`" for n, v in zip(names, col) if v == best))
+    return out
+
+
+def completeness_table(inputs):
+    if len(inputs) != 1:
+        fail("completeness: give one descriptors.json")
+    e = load_json(inputs[0], "descriptors", "a descriptors.json of semsegmap eval descriptors")
+    c, w, bands = e["completeness_estimate"], e["wake_ups"], e["bands"]
+    rows = [[f"{a['window_frames']}" + (" (used)" if a["window_frames"] == c["window_frames"]
+                                          else ""), f"{a['spearman']:.3f}",
+             f"{a['same_band']:.3f}"] for a in c["windows"]]
+    out = table([("window (frames)", 1), ("Spearman", 1), ("same band", 1)], rows)
+    confusion = c["agreement"]["confusion"]
+    rows = [[f"true {band}", *confusion[i]] for i, band in enumerate(bands)]
+    out += "\n" + table([("queries", 0)] + [(f"estimated {b}", 1) for b in bands], rows)
+    names = [d["name"] for d in e["descriptors"]]
+    wake = {d["name"]: d for d in w["descriptors"]}
+    columns = [[top16(d["estimated_band_curves"][b]) for d in e["descriptors"]]
+               for b in range(len(bands))]
+    columns.append([wake[n]["top1"] if n in wake else None for n in names])
+    columns.append([wake[n]["top16"] if n in wake else None for n in names])
+    rows = [[f"`{n}`", *("-" if col[i] is None else f"{col[i]:.3f}" for col in columns)]
+            for i, n in enumerate(names)]
+    rows.append(["leads", *leaders(columns, names)])
+    header = ([("descriptor", 0)] + [(f"top-16 estimated {b}", 1) for b in bands] +
+              [("wake-ups top-1", 1), ("wake-ups top-16", 1)])
+    out += "\n" + table(header, rows)
+    out += (f"\n{e['queries']} partial observations of {e['segments']} segments on "
+            f"{e['dataset']}; {w['queries']} segments of {w['wake_ups']} one-scan wake-ups "
+            f"(every {w['every_frames']}th frame of {w['dataset']}).\n")
+    return out
 
 
 # What each benchmark measures and the target it is held to (the brief's, or none), in the order
@@ -564,7 +614,8 @@ def fleet_table(inputs):
 TABLES = {"rigs": rigs_table, "runs": runs_table, "table-i": table_i, "configs": configs_table,
           "label-noise": label_noise_table, "label-rate": label_rate_table,
           "segmentation": segmentation_table,
-          "descriptors": descriptors_table, "benchmarks": benchmarks_table,
+          "descriptors": descriptors_table, "completeness": completeness_table,
+          "benchmarks": benchmarks_table,
           "memory": memory_table, "slam": slam_table,
           "segments": segments_table, "odometry": odometry_table,
           "revisits": revisits_table, "wake-ups": wake_ups_table,

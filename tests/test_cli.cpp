@@ -142,7 +142,7 @@ const std::vector<CommandOptions> kAllCommands = {
      {"map-run", "descriptors", "config"}},
     {"eval descriptors",
      {"world-seed", "out", "preset", "max-frames", "config", "models", "descriptors", "threads",
-      "descriptor-run"},
+      "descriptor-run", "wake-up-every", "completeness-window"},
      {"configs", "map-run"}},
     {"eval localization",
      {"world-seed", "out", "preset", "max-frames", "configs", "map-run", "query-runs",
@@ -168,7 +168,8 @@ const std::vector<CommandOptions> kAllCommands = {
      {"configs", "dataset"}},
     {"eval paper",
      {"world-seed", "out", "preset", "max-frames", "configs", "segmentation-run", "config",
-      "models", "descriptors", "threads", "descriptor-run", "map-run", "query-runs"},
+      "models", "descriptors", "threads", "descriptor-run", "wake-up-every", "completeness-window",
+      "map-run", "query-runs"},
      {"dataset"}},
 };
 
@@ -760,6 +761,16 @@ TEST(Cli, TrainsThreeDSmoothNetAndRefusesTheOptionsOfTheOthers) {
   EXPECT_NE(bytes.find("3dsmoothnet"), std::string::npos);
   EXPECT_NE(bytes.rfind("words"), std::string::npos);
   EXPECT_NE(r.out.find("(3dsmoothnet, fingerprint "), std::string::npos) << r.out;
+}
+
+// A window of no frames would estimate nothing: refused before the run is simulated.
+TEST(Cli, EvalDescriptorsRefusesACompletenessWindowOfNoFrames) {
+  if (!built("simulate")) GTEST_SKIP() << "this build has no simulator";
+  TempDir tmp;
+  const Result r = run("eval descriptors --completeness-window 0 --out " + tmp.path().string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--completeness-window: a window of at least one frame"), std::string::npos)
+      << r.err;
 }
 
 TEST(Cli, TrainChecksItsTeacherBeforeExtracting) {

@@ -146,9 +146,23 @@ TEST(Experiments, EachRunsEndToEndAndTheReportShowsThem) {
   EXPECT_GT(dj["queries"].as<size_t>(), 0u);
   for (const auto& r : dj["descriptors"]) {
     EXPECT_EQ(r["band_curves"].size(), 4u);
+    EXPECT_EQ(r["estimated_band_curves"].size(), 4u);
     EXPECT_LE(r["top1"].as<double>(), r["top16"].as<double>());
   }
   expectPng(out / "descriptors.png");
+  // The run-time completeness estimate: each window's agreement, the queries binned by it (every
+  // query in some estimated band), and the one-scan wake-ups of S2 ranked by each descriptor.
+  const YAML::Node cj = dj["completeness_estimate"];
+  EXPECT_EQ(cj["window_frames"].as<size_t>(), dc.completeness_window);
+  EXPECT_EQ(cj["windows"].size(), dc.completeness_windows.size());
+  size_t binned = 0;
+  for (const auto& n : dj["descriptors"][0]["estimated_band_counts"]) binned += n.as<size_t>();
+  EXPECT_EQ(binned, dj["queries"].as<size_t>());
+  EXPECT_EQ(d.wake_ups, 10u);  // frames 0, 5, ..., 45 of the first 50
+  EXPECT_GT(d.wake_up_queries, 0u);
+  ASSERT_EQ(dj["wake_ups"]["descriptors"].size(), 2u);
+  EXPECT_GT(dj["wake_ups"]["descriptors"][0]["top16"].as<double>(), 0.0);
+  expectPng(out / "completeness.png");
 
   LocalizationExperimentConfig lc;
   lc.preset = "tiny";

@@ -60,6 +60,7 @@ TrainingSet syntheticSet(int instances, int per_instance) {
         o.modalities.push_back(TrainingObservation::kHasColor | TrainingObservation::kHasClass);
       }
       o.n_points = 20;
+      o.frame_index = static_cast<uint32_t>(7 * i + k);
       o.purity = 1.0f;
       set.observations.push_back(std::move(o));
     }
@@ -419,6 +420,8 @@ TEST(TrainingData, CacheRoundTripsAndKnowsWhatItWasMadeFrom) {
     EXPECT_EQ(x.instance, y.instance);
     EXPECT_EQ(x.segment, y.segment);
     EXPECT_EQ(x.source, y.source);
+    EXPECT_EQ(x.n_points, y.n_points);
+    EXPECT_EQ(x.frame_index, y.frame_index);
     EXPECT_EQ(x.xyzhsv, y.xyzhsv);
     EXPECT_EQ(x.classes, y.classes);
     EXPECT_EQ(x.modalities, y.modalities);

@@ -9,6 +9,7 @@
 #include <random>
 #include <set>
 
+#include "semsegmap/segment/completeness.h"
 #include "semsegmap/segment/incremental_segmenter.h"
 #include "semsegmap/settings/config.h"
 
@@ -330,4 +331,21 @@ TEST(PipelineConfig, CountsValuesAndDirectoriesNameTheFileAndTheKey) {
               "'-5'");
   expectError("? [a, b]\n: 1\n", "the top level: a key that is a list");
   std::filesystem::remove_all(dir);
+}
+
+TEST(CompletenessEstimate, ShareOfThePointsAWindowBeforeWithARunningMaximum) {
+  // Frames 0, 2, 4: growing fast; 20: grown little since 10 frames before; 30: a spurt (merge).
+  const std::vector<ObservationSize> obs = {{0, 100}, {2, 200}, {4, 400}, {20, 440}, {30, 880}};
+  const std::vector<double> e = estimateCompleteness(obs, 10);
+  ASSERT_EQ(e.size(), obs.size());
+  EXPECT_DOUBLE_EQ(e[0], 0.0);  // nothing a window before the first observation
+  EXPECT_DOUBLE_EQ(e[1], 0.0);
+  EXPECT_DOUBLE_EQ(e[2], 0.0);
+  EXPECT_DOUBLE_EQ(e[3], 400.0 / 440.0);  // frame 10's size is frame 4's observation
+  EXPECT_DOUBLE_EQ(e[4], 400.0 / 440.0);  // 440/880 is less: the running maximum holds
+  // The window decides what counts as before: with 2 frames, frame 2 sees frame 0's 100 points.
+  const std::vector<double> short_window = estimateCompleteness(obs, 2);
+  EXPECT_DOUBLE_EQ(short_window[1], 0.5);
+  EXPECT_DOUBLE_EQ(short_window[2], 0.5);
+  EXPECT_TRUE(estimateCompleteness({}, 10).empty());
 }

@@ -84,6 +84,10 @@ DescriptorExperimentConfig descriptorConfig(const CliArgs& a) {
   c.segmentation = loadNamedConfig(a.getPath("config"));
   c.models = a.getPath("models");
   c.threads = static_cast<int>(a.getCount("threads"));
+  c.wake_up_every = a.getCount("wake-up-every");
+  c.completeness_window = a.getCount("completeness-window");
+  if (c.completeness_window == 0)
+    throw UsageError("--completeness-window: a window of at least one frame");
   return c;
 }
 
@@ -167,8 +171,9 @@ int runEvalDescriptors(const CliArgs& a) {
   const DescriptorExperiment e = evaluateDescriptors(c, std::ref(progress));
   if (e.interrupted && !progress.started()) return experimentEnd(a, true, progress);
   writeDescriptorFiles(e, out);
-  std::cout << descriptorTable(e) << "wrote " << (out / "descriptors.json").string()
-            << ", descriptors.png\n";
+  std::cout << descriptorTable(e) << "\n"
+            << completenessTable(e) << "wrote " << (out / "descriptors.json").string()
+            << ", descriptors.png, completeness.png\n";
   return experimentEnd(a, e.interrupted, progress);
 }
 
@@ -264,6 +269,11 @@ const OptionSpec kModels{"models", Value::kText, "DIR", "models",
                          "folder of the learned descriptors' models (default: the shipped models)"};
 const OptionSpec kDescriptors{"descriptors", Value::kText, "LIST", builtDescriptors(),
                               "the descriptors compared, of those this build has"};
+const OptionSpec kWakeUpEvery{"wake-up-every", Value::kCount, "N", "5",
+                              "one-scan wake-ups on every N-th frame of S2, 0: none"};
+const OptionSpec kCompletenessWindow{
+    "completeness-window", Value::kCount, "FRAMES", "10",
+    "window of the run-time completeness estimate (a segment's growth over it)"};
 const OptionSpec kThreads{"threads", Value::kCount, "N", "0",
                           "threads that describe segments, 0: all cores"};
 const OptionSpec kMapRun{"map-run", Value::kText, "S0|S1|S2|S3", "S0",
@@ -298,7 +308,7 @@ const std::vector<const CommandSpec*>& simulatedEvalCommands() {
       "eval descriptors",
       "retrieval of segments from their partial observations -> descriptors.json",
       {kWorldSeed, kOut, kPreset, kMaxFrames, kConfig, kModels, kDescriptors, kThreads,
-       kDescriptorRun},
+       kDescriptorRun, kWakeUpEvery, kCompletenessWindow},
       "",
       runEvalDescriptors,
       /*stops_between_frames=*/true};
@@ -331,7 +341,8 @@ const std::vector<const CommandSpec*>& simulatedEvalCommands() {
       "eval paper",
       "the segmentation, descriptor and localization experiments, and report.md",
       {kWorldSeed, kOut, kPreset, kMaxFrames, kConfigs, kSegmentationRun, kConfig, kModels,
-       kDescriptors, kThreads, kDescriptorRun, kMapRun, kQueryRuns},
+       kDescriptors, kThreads, kDescriptorRun, kWakeUpEvery, kCompletenessWindow, kMapRun,
+       kQueryRuns},
       "",
       runEvalPaper,
       /*stops_between_frames=*/true};

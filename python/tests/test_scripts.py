@@ -147,6 +147,31 @@ def test_descriptor_table_takes_top_16_of_each_band(tmp_path):
     assert rows[2] == "| `eigen` | 0.100 | 0.500 | 0.160 | 1000 |"
 
 
+def test_completeness_table_names_the_leader_of_each_estimated_band_and_the_wake_ups(tmp_path):
+    desc = tmp_path / "descriptors.json"
+    curve = lambda top16: [top16] * 20  # noqa: E731
+    desc.write_text(json.dumps({
+        "dataset": "sim:world=1,run=S0", "segments": 5, "queries": 9,
+        "bands": ["<30%", ">=30%"],
+        "completeness_estimate": {"window_frames": 10, "agreement": {
+            "window_frames": 10, "spearman": 0.5, "same_band": 0.6,
+            "confusion": [[3, 1], [2, 4]]}, "windows": [
+            {"window_frames": 5, "spearman": 0.4, "same_band": 0.5, "confusion": []},
+            {"window_frames": 10, "spearman": 0.5, "same_band": 0.6, "confusion": []}]},
+        "wake_ups": {"dataset": "sim:world=1,run=S2", "every_frames": 20, "wake_ups": 3,
+                     "queries": 7, "descriptors": [
+                         {"name": "a", "top1": 0.1, "top16": 0.3},
+                         {"name": "b", "top1": 0.2, "top16": 0.3}]},
+        "descriptors": [
+            {"name": "a", "estimated_band_curves": [curve(0.5), curve(0.9)]},
+            {"name": "b", "estimated_band_curves": [curve(0.6), curve(0.8)]}]}))
+    rows = write_table(tmp_path, "completeness", [str(desc)])
+    assert "| 10 (used) | 0.500 | 0.600 |" in rows
+    assert "| true <30% | 3 | 1 |" in rows
+    assert "| `a` | 0.500 | 0.900 | 0.100 | 0.300 |" in rows
+    assert "| leads | `b` | `a` | `b` | `a`, `b` |" in rows
+
+
 def test_benchmark_table_reads_google_benchmarks_json(tmp_path):
     bench = tmp_path / "bench.json"
     bench.write_text(json.dumps({"context": {"num_cpus": 2, "mhz_per_cpu": 2445,

@@ -2,8 +2,8 @@
 //   "SSMTRAIN" u32 version | str provenance | u32 n, n x (str source, str world) |
 //   u64 n, n x observation | u64 FNV-1a of every byte before it
 // str = u32 length + bytes; observation = u16 instance, u16 class, u16 source, i64 segment,
-//   u32 n_points, f32 purity, 3 x f32 centroid, u32 count, count x 6 f32, count x u16 class,
-//   count x u8 modalities (1: has colour, 2: has a class).
+//   u32 n_points, u32 frame index, f32 purity, 3 x f32 centroid, u32 count, count x 6 f32, count x
+//   u16 class, count x u8 modalities (1: has colour, 2: has a class).
 #include "semsegmap/artefacts/training_cache.h"
 
 #include <algorithm>
@@ -22,8 +22,9 @@ constexpr std::string_view kCacheMagic("SSMTRAIN", 8);
 // 3: the checksum covers the whole file (core/binary_io.h), as in the other formats.
 // 4: a point's byte holds whether it has a class besides whether it has colour (unobserved
 // points); a cache of another version is extracted again.
-constexpr uint32_t kVersion = 4;
-constexpr size_t kFixedObservationBytes = 2 + 2 + 2 + 8 + 4 + 4 + 12 + 4;
+// 5: an observation's frame index (its segment's growth over time, eval/completeness).
+constexpr uint32_t kVersion = 5;
+constexpr size_t kFixedObservationBytes = 2 + 2 + 2 + 8 + 4 + 4 + 4 + 12 + 4;
 constexpr size_t kPointBytes = 6 * 4 + 2 + 1;
 
 void putObservation(BinaryWriter& w, const TrainingObservation& o) {
@@ -32,6 +33,7 @@ void putObservation(BinaryWriter& w, const TrainingObservation& o) {
   w.put(o.source);
   w.put(o.segment);
   w.put(o.n_points);
+  w.put(o.frame_index);
   w.put(o.purity);
   for (int k = 0; k < 3; ++k) w.put(o.centroid[k]);
   w.put(static_cast<uint32_t>(o.size()));
@@ -48,6 +50,7 @@ TrainingObservation getObservation(BinaryReader& r, size_t sources) {
   if (o.source >= sources) r.fail("corrupt training cache (bad source index)");
   o.segment = r.get<int64_t>("an observation");
   o.n_points = r.get<uint32_t>("an observation");
+  o.frame_index = r.get<uint32_t>("an observation");
   o.purity = r.get<float>("an observation");
   for (int k = 0; k < 3; ++k) o.centroid[k] = r.get<float>("an observation");
   const uint32_t n = r.get<uint32_t>("an observation");

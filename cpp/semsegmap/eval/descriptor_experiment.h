@@ -23,6 +23,15 @@ struct DescriptorExperimentConfig {
   std::vector<std::string> descriptors = {"semsegmap-net", "segmap-cnn", "fpfh", "eigen"};
   int threads = 0;
   int max_k = 50;
+  // The run-time completeness estimate's window (segment/completeness.h), frames; the agreement
+  // of the others of `completeness_windows` is reported beside it.
+  size_t completeness_window = 10;
+  std::vector<size_t> completeness_windows = {3, 5, 10, 20, 40};
+  // One-scan wake-ups: every wake_up_every-th frame of `wake_up_run` (the same world) segmented
+  // on its own by a pipeline started empty, its segments looking for their landmark among the
+  // final observations of `run`. 0: none.
+  std::string wake_up_run = "S2";
+  size_t wake_up_every = 5;
   // Checked before each frame and each descriptor (Ctrl-C in the CLI): the segments of the
   // frames done are ranked by the descriptors done.
   StopToken stop;
@@ -34,7 +43,12 @@ struct DescriptorExperiment {
   size_t segments = 0, queries = 0;
   std::vector<CompletenessBand> bands;
   std::vector<DescriptorRetrieval> results;
-  bool interrupted = false;  // the stop request ended it early
+  CompletenessAgreement agreement;             // of the configured window
+  std::vector<CompletenessAgreement> windows;  // of each of completeness_windows
+  std::string wake_up_dataset;
+  size_t wake_ups = 0, wake_up_queries = 0;
+  std::vector<DescriptorRetrieval> wake_up_results;  // per descriptor, bands of true completeness
+  bool interrupted = false;                          // the stop request ended it early
 };
 
 // Segments the run and ranks the observations with every descriptor; writes nothing.
@@ -53,5 +67,8 @@ DescriptorExperiment runDescriptorExperiment(const DescriptorExperimentConfig& c
                                              const ExperimentProgress& progress = {});
 
 std::string descriptorTable(const DescriptorExperiment& e);  // Markdown: top-1, top-16 per band
+// Markdown: the estimate's agreement per window, then top-16 per estimated band and on the
+// one-scan wake-ups, per descriptor.
+std::string completenessTable(const DescriptorExperiment& e);
 
 }  // namespace semsegmap

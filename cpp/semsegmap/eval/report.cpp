@@ -115,7 +115,12 @@ std::string descriptorSection(const DescriptorExperiment& e) {
   r << "## Descriptor retrieval (paper IV-C)\n\n"
     << "On " << e.dataset << ": " << e.queries << " partial observations of " << e.segments
     << " segments, each ranked against the final observations of all segments.\n\n"
-    << descriptorTable(e) << "\n![descriptors](descriptors.png)\n\n";
+    << descriptorTable(e) << "\n![descriptors](descriptors.png)\n\n"
+    << "Completeness estimated at run time from each segment's growth (its agreement with the "
+       "simulator's per window), retrieval per estimated band, and on "
+    << e.wake_ups << " one-scan wake-ups on " << e.wake_up_dataset << " (" << e.wake_up_queries
+    << " segments):\n\n"
+    << completenessTable(e) << "\n![completeness](completeness.png)\n\n";
   return r.str();
 }
 

@@ -38,6 +38,7 @@ TrainingObservation compact(const SegmentObservation& obs, uint16_t source, Segm
   t.source = source;
   t.segment = segment;
   t.n_points = static_cast<uint32_t>(obs.n_points);
+  t.frame_index = static_cast<uint32_t>(obs.frame_index);
   t.purity = obs.gt_purity;
   t.centroid = obs.centroid.cast<float>();
   std::vector<uint32_t> keep(obs.points.size());

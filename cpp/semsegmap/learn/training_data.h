@@ -26,6 +26,7 @@ struct TrainingObservation {
   uint16_t source = 0;                                 // index into TrainingSet::sources
   int64_t segment = 0;                                 // segment id within that source's run
   uint32_t n_points = 0;                               // before subsampling (the loss's sigma)
+  uint32_t frame_index = 0;                            // the frame it was taken at
   float purity = 0.0f;                                 // share of the points of `instance`
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();  // map frame
   std::vector<float> xyzhsv;                           // 6 floats a stored point, map frame
