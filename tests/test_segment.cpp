@@ -285,6 +285,8 @@ TEST(PipelineConfig, UnknownKeysAndBadValuesNameTheFile) {
   expectError("refinement:\n  neighbours_m: -3\n", "refinement.neighbours_m");  // an old key
   expectError("localization:\n  latest_scan_fallback_m: -5\n",
               "localization.latest_scan_fallback_m");
+  expectError("descriptor:\n  kind: semsegmap-net\n  keypoints: 16\n",
+              "descriptor.keypoints: only for 3dsmoothnet");
   std::filesystem::remove(path);
   EXPECT_THROW(loadPipelineConfig("/nonexistent/config.yaml"), std::runtime_error);
 }

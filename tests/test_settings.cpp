@@ -85,6 +85,7 @@ std::map<std::string, std::string> withCompanions(const std::string& key,
   if (key == "semantics.input_width") values["semantics.input_height"] = "8";
   if (key == "semantics.input_height") values["semantics.input_width"] = "8";
   if (key == "descriptor.model_lidar_only") values["descriptor.model"] = "/elsewhere/model";
+  if (key == "descriptor.keypoints") values["descriptor.kind"] = "3dsmoothnet";
   return values;
 }
 

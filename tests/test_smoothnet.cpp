@@ -191,6 +191,29 @@ TEST(SmoothNet, BagOfWordsRoundTripsThroughTheModelFile) {
       EXPECT_NEAR(d(i, j) * 6.0f, std::round(d(i, j) * 6.0f), 1e-5f);
   }
 
+  // descriptor.keypoints: another sample size is another describer (its fingerprint says so, so
+  // no map built with the model's is queried with it); the model's own changes nothing.
+  DescriberOptions ten;
+  ten.net = loaded;
+  ten.threads = 1;
+  ten.smoothnet_keypoints = 10;
+  const auto more = makeDescriber(DescriptorKind::kSmoothNetBow, ten);
+  EXPECT_EQ(more->fingerprint(), describer->fingerprint() + "/keypoints=10");
+  const Eigen::MatrixXf d10 = more->describe({{&a}, {&b}});
+  for (Eigen::Index i = 0; i < d10.rows(); ++i) {
+    EXPECT_NEAR(d10.row(i).sum(), 1.0f, 1e-6f);
+    for (Eigen::Index j = 0; j < d10.cols(); ++j)  // now multiples of 1/10
+      EXPECT_NEAR(d10(i, j) * 10.0f, std::round(d10(i, j) * 10.0f), 1e-5f);
+  }
+  ten.smoothnet_keypoints = 6;
+  EXPECT_EQ(makeDescriber(DescriptorKind::kSmoothNetBow, ten)->fingerprint(),
+            describer->fingerprint());
+  DescriptorConfig from_yaml;  // the pipeline config's descriptor.keypoints reaches the describer
+  from_yaml.kind = "3dsmoothnet";
+  from_yaml.model = path.string();
+  from_yaml.keypoints = 10;
+  EXPECT_EQ(makeDescriber(from_yaml, 1)->fingerprint(), more->fingerprint());
+
   // A 3dsmoothnet header of a version before 4 cannot be: refused, naming the file.
   std::string bytes = readFileBytes(path);
   bytes[6] = 3;

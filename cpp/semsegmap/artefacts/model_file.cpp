@@ -185,6 +185,7 @@ std::unique_ptr<Describer> makeDescriber(const DescriptorConfig& config, int thr
   const DescriptorKind kind = parseDescriptorKind(config.kind);
   DescriberOptions options;
   options.threads = threads;
+  options.smoothnet_keypoints = config.keypoints;
 #if SEMSEGMAP_WITH_TORCH
   // Loading the network is the calling thread's first use of torch (learned_describer.h).
   const KeepOpenMpThreads keep;

@@ -55,6 +55,8 @@ class DescriptorNetImpl;  // describe/learned_net.h
 struct DescriberOptions {
   std::shared_ptr<DescriptorNetImpl> net;  // required for the learned descriptors (loadNet)
   int threads = 0;                         // 0: all cores
+  // 3dsmoothnet: keypoints a segment is described at instead of the model's; 0: the model's.
+  int smoothnet_keypoints = 0;
 };
 
 // Throws std::invalid_argument for a learned kind without a network or with one of another kind,

@@ -66,6 +66,16 @@ class LearnedDescriber : public Describer {
     net_ = options.net;
     net_->eval();
     fingerprint_ = netFingerprint(*net_);
+    config_ = net_->config();
+    if (options.smoothnet_keypoints > 0 &&
+        options.smoothnet_keypoints != config_.smoothnet_keypoints) {
+      if (kind != DescriptorKind::kSmoothNetBow)
+        throw std::invalid_argument("makeLearnedDescriber: keypoints are 3dsmoothnet's, not " +
+                                    descriptorName(kind) + "'s");
+      // Other keypoints, other descriptors: a map built with them is another map.
+      config_.smoothnet_keypoints = options.smoothnet_keypoints;
+      fingerprint_ += "/keypoints=" + std::to_string(config_.smoothnet_keypoints);
+    }
   }
 
   DescriptorKind kind() const override { return kind_; }
@@ -126,7 +136,7 @@ class LearnedDescriber : public Describer {
     std::vector<const EnrichedCloud*> segments(count);
     for (size_t i = 0; i < count; ++i) segments[i] = batch[begin + i].points;
     const NetInput input =
-        makeNetInput(net_->config(), segments, std::vector<uint64_t>(count, kInferenceSalt));
+        makeNetInput(config_, segments, std::vector<uint64_t>(count, kInferenceSalt));
     const torch::Tensor descriptors = net_->encode(input).contiguous();
     const float* d = descriptors.data_ptr<float>();
     const int dim = dimension();
@@ -140,6 +150,7 @@ class LearnedDescriber : public Describer {
   DescriptorKind kind_;
   int threads_;
   std::shared_ptr<DescriptorNetImpl> net_;
+  NetConfig config_;  // the network's, with the describer's keypoints
   std::string fingerprint_;
 };
 

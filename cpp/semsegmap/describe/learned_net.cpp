@@ -66,6 +66,7 @@ NetInput makeNetInput(const NetConfig& config, const std::vector<const EnrichedC
   } else if (config.kind == DescriptorKind::kSmoothNetBow) {
     const int64_t k = config.smoothnet_keypoints, g = config.smoothnet_voxels;
     in.sdv = torch::empty({b * k, 1, g, g, g});
+    in.keypoints = k;
     at::parallel_for(0, b, 1, [&](int64_t begin, int64_t end) {
       for (int64_t i = begin; i < end; ++i)
         copyInto(in.sdv, i,

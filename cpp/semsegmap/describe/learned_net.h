@@ -30,6 +30,7 @@ struct NetInput {
   torch::Tensor target_occupancy;  // decoder target, [B, 1, D, D, D] (or the cnn's own grid)
   torch::Tensor n_points;          // [B] float: points in each segment before subsampling
   torch::Tensor sdv;               // 3dsmoothnet: [B * smoothnet_keypoints, 1, G, G, G] SDV grids
+  int64_t keypoints = 0;           // 3dsmoothnet: the smoothnet_keypoints the grids were made at
 };
 
 struct NetOutput {

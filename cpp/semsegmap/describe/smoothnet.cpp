@@ -71,7 +71,9 @@ void SmoothNetImpl::setWords(const torch::Tensor& words) {
 }
 
 torch::Tensor SmoothNetImpl::encode(const NetInput& input) {
-  const int64_t k = config_.smoothnet_keypoints;
+  // The describer may sample more or fewer keypoints than the model was trained with
+  // (descriptor.keypoints): the bag is a share of the keypoints either way.
+  const int64_t k = input.keypoints > 0 ? input.keypoints : config_.smoothnet_keypoints;
   if (!input.sdv.defined() || input.sdv.size(0) % k != 0)
     throw std::invalid_argument("3dsmoothnet: the input holds no SDV grids of " +
                                 std::to_string(k) + " keypoints a segment");

@@ -22,6 +22,9 @@ struct DescriptorConfig {
   // Optional: the model taken instead for input with neither colour nor classes (a LiDAR
   // without a camera; pipeline/input_modalities.h).
   std::string model_lidar_only;
+  // 3dsmoothnet: random keypoints a segment is described at (its bag of words' sample); 0: the
+  // model's (train --keypoints). More keypoints give a steadier histogram for more time.
+  int keypoints = 0;
 };
 
 struct LocalizationConfig {

@@ -142,13 +142,16 @@ std::vector<Setting> frontEndSettings() {
              "a segment grown by this share of its points is observed again"),
       flag(SEMSEGMAP_AT(segmentation.keep_all_observation_points), kNotRecorded,
            "keep every observation's points, not only the latest (training data)"),
-      text(SEMSEGMAP_AT(descriptor.kind), "semsegmap-net, segmap-cnn, eigen or fpfh"),
+      text(SEMSEGMAP_AT(descriptor.kind), "semsegmap-net, segmap-cnn, 3dsmoothnet, eigen or fpfh"),
       text(SEMSEGMAP_AT(descriptor.model),
            "model file of a learned descriptor, relative to the config file"),
       text(SEMSEGMAP_AT(descriptor.model_lidar_only),
            "the model taken instead for input with neither colour nor classes"),
       count(SEMSEGMAP_AT(descriptor.batch), 1, 4096, kNotRecorded,
             "segments described per forward pass"),
+      // Not recorded: the describer's fingerprint, which the map keeps, says it instead.
+      count(SEMSEGMAP_AT(descriptor.keypoints), 0, 1024, kNotRecorded,
+            "3dsmoothnet: keypoints a segment is described at, 0: the model's"),
   };
 }
 

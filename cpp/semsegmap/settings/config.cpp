@@ -280,6 +280,7 @@ void checkPipelineSettings(const std::filesystem::path& path, const Settings& c)
         "segmentation: penalties must not be negative");
   check(sg.min_segment_points <= sg.max_segment_points,
         "segmentation.min_segment_points: must not exceed max_segment_points");
+  check(d.keypoints == 0 || d.kind == "3dsmoothnet", "descriptor.keypoints: only for 3dsmoothnet");
   check(d.model_lidar_only.empty() || !d.model.empty(),
         "descriptor.model_lidar_only: only for a learned descriptor (one with a model)");
   check(vf.resolution_m > 0, "localization.localizer.verification.resolution_m: must be positive");
