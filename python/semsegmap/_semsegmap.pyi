@@ -189,6 +189,7 @@ class DescriptorConfig:
     model: str
     model_lidar_only: str
     batch: int
+    keypoints: int
     def __init__(self, **fields: object) -> None: ...
 
 class DescriptorIndexConfig:

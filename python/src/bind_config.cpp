@@ -53,7 +53,9 @@ void bindFrontEndConfigs(py::module_& m) {
       .field("model", &DescriptorConfig::model, "model file of a learned descriptor")
       .field("model_lidar_only", &DescriptorConfig::model_lidar_only,
              "the model taken instead for input with neither colour nor classes")
-      .field("batch", &DescriptorConfig::batch, "segments described per forward pass");
+      .field("batch", &DescriptorConfig::batch, "segments described per forward pass")
+      .field("keypoints", &DescriptorConfig::keypoints,
+             "3dsmoothnet: keypoints a segment is described at, 0: the model's");
 }
 
 void bindLocalizationConfigs(py::module_& m) {
