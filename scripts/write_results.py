@@ -196,26 +196,40 @@ def label_noise_table(inputs):
 
 
 def label_rate_table(inputs):
-    """Within 1 m per run for SemSegMap and SegMap, SemSegMap's lead (x SegMap's), the wrong
-    ones and the network's share of the cores, a row per way of making the camera labels."""
-    rows, runs = [], []
+    """Within 1 m per run for SemSegMap and SegMap, SemSegMap's lead (x SegMap's), with a row of
+    perfect labels among them SemSegMap's share of its count with perfect labels, the wrong ones
+    and the network's share of the cores, a row per way of making the camera labels."""
+    found_rows, runs = [], []
     for labels, path in labelled(inputs):
         # The label names the kind to take from a file of several: "perfect", "network".
         results = results_with_labels(path, labels.split(" ")[0])
-        found = {(r["run"], r["config"]): r for r in results}
+        found_rows.append((labels, results, {(r["run"], r["config"]): r for r in results}))
         runs = runs or sorted({r["run"] for r in results})
+
+    def within_1m(found, run, config):
+        return found.get((run, config), {}).get("n_error_below_1m")
+
+    perfect = next((f for labels, _, f in found_rows if labels.split(" ")[0] == "perfect"), None)
+    rows = []
+    for labels, results, found in found_rows:
         row = [labels]
         for run in runs:
-            sem = found.get((run, "semsegmap"), {}).get("n_error_below_1m")
-            seg = found.get((run, "segmap"), {}).get("n_error_below_1m")
+            sem, seg = within_1m(found, run, "semsegmap"), within_1m(found, run, "segmap")
             lead = f"{sem / seg:.2f}" if sem is not None and seg else "-"
             row += [shown(sem), shown(seg), lead]
+            if perfect is not None:
+                best = within_1m(perfect, run, "semsegmap")
+                of = (f"{100 * sem / best:.1f} %" if sem is not None and best and found is not
+                      perfect else "-")
+                row.append(of)
         share = max((r.get("network_share_of_cores", 0.0) for r in results), default=0.0)
         row += [sum(r["n_wrong"] for r in results), f"{share:.2f}" if share else "-"]
         rows.append(row)
     header = [("camera labels", 0)]
     for run in runs:
         header += [(f"{run} semsegmap", 1), (f"{run} segmap", 1), (f"{run} lead", 1)]
+        if perfect is not None:
+            header.append((f"{run} semsegmap of perfect", 1))
     return table(header + [("wrong", 1), ("network cores", 1)], rows)
 
 

@@ -93,11 +93,14 @@ def test_label_rate_table_takes_each_kind_of_labels_from_a_file_of_several(tmp_p
         labelled("S2", "segmap", 0, "network,rate=1", 0.05)])
     rows = write_table(tmp_path, "label-rate", [
         f"perfect={demo}", f"network at the shipped budget={demo}", f"network at 1 Hz={rate}"])
-    assert rows[0] == ("| camera labels | S2 semsegmap | S2 segmap | S2 lead | wrong "
-                       "| network cores |")
-    assert rows[2:] == ["| perfect | 30 | 20 | 1.50 | 0 | - |",
-                        "| network at the shipped budget | 24 | 16 | 1.50 | 0 | 0.25 |",
-                        "| network at 1 Hz | 9 | 0 | - | 0 | 0.05 |"]
+    assert rows[0] == ("| camera labels | S2 semsegmap | S2 segmap | S2 lead "
+                       "| S2 semsegmap of perfect | wrong | network cores |")
+    assert rows[2:] == ["| perfect | 30 | 20 | 1.50 | - | 0 | - |",
+                        "| network at the shipped budget | 24 | 16 | 1.50 | 80.0 % | 0 | 0.25 |",
+                        "| network at 1 Hz | 9 | 0 | - | 30.0 % | 0 | 0.05 |"]
+    # Without a row of perfect labels there is nothing to be a share of.
+    rows = write_table(tmp_path, "label-rate", [f"network at 1 Hz={rate}"])
+    assert rows[2:] == ["| network at 1 Hz | 9 | 0 | - | 0 | 0.05 |"]
     # The label-noise table takes the perfect rows of a file with the network's too.
     assert write_table(tmp_path, "label-noise", [f"0={demo}"])[2] == "| 0 | 30 | 20 | 0 |"
 
@@ -113,8 +116,8 @@ def test_label_rate_table_takes_a_label_pass_by_its_folder(tmp_path):
         passed("segmap", 6, "network,rate=2", "network_rate-2/")])
     rows = write_table(tmp_path, "label-rate", [
         f"perfect={both}", f"network at 2 Hz={both}#network_rate-2"])
-    assert rows[2:] == ["| perfect | 30 | 20 | 1.50 | 0 | - |",
-                        "| network at 2 Hz | 12 | 6 | 2.00 | 0 | - |"]
+    assert rows[2:] == ["| perfect | 30 | 20 | 1.50 | - | 0 | - |",
+                        "| network at 2 Hz | 12 | 6 | 2.00 | 40.0 % | 0 | - |"]
     doc = tmp_path / "doc.md"
     failed = subprocess.run([sys.executable, source_file("scripts/write_results.py"), "s",
                              f"x={both}#network_rate-9", "--table", "label-rate", "--doc",
@@ -204,6 +207,12 @@ def test_benchmark_table_takes_the_fastest_repetition_with_its_local_map_time(tm
     assert rows[2].endswith(
         "| `BM_WholePipeline/0/1000` | >= 10 Hz | 25.0 Hz (40.0 ms), local map + segmentation "
         "20.0 ms |"), rows
+    # A later file's run of a benchmark (the pipeline's rows in a process of their own) wins.
+    alone = tmp_path / "alone.json"
+    alone.write_text(json.dumps({"context": {}, "benchmarks": [dict(runs[1], real_time=30,
+                                                                    Hz=1000 / 30)]}))
+    rows = write_table(tmp_path, "benchmarks", [str(bench), str(alone)])
+    assert rows[2].endswith("33.3 Hz (30.0 ms), local map + segmentation 20.0 ms |"), rows
     # Aggregates alone (--benchmark_report_aggregates_only): their mean.
     bench.write_text(json.dumps({"context": {"num_cpus": 2, "mhz_per_cpu": 2445,
                                              "date": "2026-12-06T11:10:00+00:00"},
