@@ -19,12 +19,22 @@ std::vector<CompletenessBand> defaultCompletenessBands() {
           {0.9, std::numeric_limits<double>::infinity(), ">=90%"}};
 }
 
-RetrievalQueries makeRetrievalQueries(const TrainingSet& set, size_t min_observations) {
+namespace {
+
+// The observations of each segment (of each source), in the order they were taken.
+std::map<std::pair<uint16_t, int64_t>, std::vector<size_t>> observationsBySegment(
+    const TrainingSet& set) {
   std::map<std::pair<uint16_t, int64_t>, std::vector<size_t>> by_segment;
   for (size_t i = 0; i < set.observations.size(); ++i)
     by_segment[{set.observations[i].source, set.observations[i].segment}].push_back(i);
+  return by_segment;
+}
+
+}  // namespace
+
+RetrievalQueries makeRetrievalQueries(const TrainingSet& set, size_t min_observations) {
   RetrievalQueries q;
-  for (const auto& [key, obs] : by_segment) {
+  for (const auto& [key, obs] : observationsBySegment(set)) {
     if (obs.size() < min_observations) continue;
     // The final observation is the last one, as in training (learn/finalObservations): it is
     // the one the segment leaves the local map with, so the one a target map stores. A merge or
@@ -71,11 +81,8 @@ RetrievalQueries makeWakeUpQueries(const TrainingSet& set, const std::vector<siz
 }
 
 std::vector<double> estimatedCompleteness(const TrainingSet& set, size_t window_frames) {
-  std::map<std::pair<uint16_t, int64_t>, std::vector<size_t>> by_segment;
-  for (size_t i = 0; i < set.observations.size(); ++i)
-    by_segment[{set.observations[i].source, set.observations[i].segment}].push_back(i);
   std::vector<double> out(set.observations.size(), 0.0);
-  for (const auto& [key, obs] : by_segment) {
+  for (const auto& [key, obs] : observationsBySegment(set)) {
     std::vector<ObservationSize> sizes;
     for (size_t i : obs)
       sizes.push_back({set.observations[i].frame_index, set.observations[i].n_points});
