@@ -7,6 +7,7 @@
 
 #include "semsegmap/core/atomic_file.h"
 #include "semsegmap/semantics/segmentation_network.h"
+#include "semsegmap/settings/config.h"
 
 using namespace semsegmap;
 
@@ -40,13 +41,11 @@ BENCHMARK(BM_SegmentationNetwork)
     ->MinTime(3.0);
 
 // The shipped network (models/semsegmap-seg.onnx, trained on the simulator) as
-// config/semantics-sim-network.yaml runs it: a 640x480 picture shrunk to 320x240, logits at
-// 160x120 upsampled back. Arg: OpenCV's threads.
+// config/semantics-sim-network.yaml runs it: a 640x480 picture shrunk to the file's input size,
+// logits at half of it upsampled back. Arg: OpenCV's threads.
 void BM_ShippedSegmentationNetwork(benchmark::State& state) {
-  SemanticsConfig config;
-  config.model = std::string(SEMSEGMAP_SOURCE_DIR) + "/models/semsegmap-seg.onnx";
-  config.input_width = 320;
-  config.input_height = 240;
+  SemanticsConfig config =
+      loadSemanticsConfig(std::string(SEMSEGMAP_SOURCE_DIR) + "/config/semantics-sim-network.yaml");
   config.threads = static_cast<int>(state.range(0));
   SegmentationNetwork network(config, readFileBytes(config.model),
                               ClassMap::Identity(ClassTable::Default()), config.model);
