@@ -209,6 +209,12 @@ nlohmann::ordered_json toJson(const LocalizationResult& r) {
           {"cumulative", r.cumulative}};
 }
 
+// A configuration's name, and where its labels came from when not the simulator's: the legend and
+// the table tell the label passes apart.
+std::string configText(const LocalizationResult& r) {
+  return r.labels.empty() || r.labels == "perfect" ? r.config : r.config + ", " + r.labels;
+}
+
 // The paper's accuracy figure: localizations within each error threshold, a panel per query run
 // done (an interrupted experiment may not have run them all).
 std::vector<viz::Panel> accuracyPanels(const LocalizationExperiment& e) {
@@ -226,7 +232,7 @@ std::vector<viz::Panel> accuracyPanels(const LocalizationExperiment& e) {
     for (const LocalizationResult& r : e.results) {
       if (r.run != run_name) continue;
       viz::Series s;
-      s.name = r.config;
+      s.name = configText(r);
       s.x = e.thresholds;
       for (size_t v : r.cumulative) s.y.push_back(static_cast<double>(v));
       p.series.push_back(std::move(s));
@@ -316,13 +322,6 @@ LocalizationExperiment runLocalizationExperiment(const LocalizationExperimentCon
   writeLocalizationFiles(e, out);
   return e;
 }
-
-namespace {
-// A configuration's name, and where its labels came from when not the simulator's.
-std::string configText(const LocalizationResult& r) {
-  return r.labels.empty() || r.labels == "perfect" ? r.config : r.config + ", " + r.labels;
-}
-}  // namespace
 
 std::string localizationTable(const LocalizationExperiment& e) {
   std::ostringstream t;
