@@ -119,6 +119,7 @@ const std::vector<CommandOptions> kAllCommands = {
       "threads",
       "config",
       "max-frames",
+      "labels",
       "cache",
       "anchors-per-epoch",
       "lr",
@@ -505,6 +506,7 @@ TEST(Cli, EvalLocalizationLabelsAreCheckedBeforeTheWork) {
       {"network,speed=2", "--labels: unknown key 'speed=2'"},
       {"perfect+netwrk", "--labels expects perfect or network"},
       {"network,ground=sideways", "--labels: unknown key 'ground=sideways'"},
+      {"network,descriptor=mine", "--labels: unknown key 'descriptor=mine'"},
       {"perfect+network,every+perfect", "--labels: 'perfect' is given twice"},
       {"+", "--labels: no label pass given"},
   };
@@ -771,6 +773,24 @@ TEST(Cli, EvalDescriptorsRefusesACompletenessWindowOfNoFrames) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--completeness-window: a window of at least one frame"), std::string::npos)
       << r.err;
+}
+
+// train --labels reads as eval localization's, and is checked before the runs are extracted.
+TEST(Cli, TrainChecksItsLabelsBeforeExtracting) {
+  if (!built("train")) GTEST_SKIP() << "this build has no train (SEMSEGMAP_WITH_TORCH=OFF)";
+  TempDir tmp;
+  const std::string train = "train --descriptor semsegmap-net --dataset sim:nowhere --out " +
+                            (tmp.path() / "m.model").string() + " --labels ";
+  const Result typo = run(train + "netwrk");
+  EXPECT_EQ(typo.code, 2);
+  EXPECT_NE(typo.err.find("--labels expects perfect or network"), std::string::npos) << typo.err;
+  const Result missing = run(train + "network,config=/nonexistent.yaml");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("/nonexistent.yaml"), std::string::npos) << missing.err;
+  // The shipped network passes the check: the dataset is what fails.
+  const Result shipped = run(train + "network");
+  EXPECT_EQ(shipped.code, 1);
+  EXPECT_NE(shipped.err.find("sim:nowhere"), std::string::npos) << shipped.err;
 }
 
 TEST(Cli, TrainChecksItsTeacherBeforeExtracting) {

@@ -255,6 +255,16 @@ TEST(LocalizationExperiment, PassesOnTheSameFramesGiveWhatEachGivesAlone) {
   evaluateLocalization(c, tmp.path() / "classes");
   EXPECT_NE(readFileBytes(tmp.path() / "classes/maps/semsegmap.map"),
             readFileBytes(tmp.path() / "network/maps/semsegmap.map"));
+  // So is its descriptor: the model the network's file names describes the pass's segments.
+  network.geometric_ground_removal = true;
+  network.descriptor_kind = "semsegmap-net";
+  network.descriptor_model = kSource + "/models/semsegmap-net-network.model";
+  c.label_passes = {network};
+  const LocalizationExperiment described = evaluateLocalization(c, tmp.path() / "described");
+  EXPECT_NE(readFileBytes(tmp.path() / "described/maps/semsegmap.map"),
+            readFileBytes(tmp.path() / "network/maps/semsegmap.map"));
+  EXPECT_EQ(toJson(described)["label_passes"][0]["descriptor"]["model"].get<std::string>(),
+            network.descriptor_model);
 }
 
 // [fleet]: two drives of one route on their own LiDAR odometry, the second joined to the first's

@@ -7,9 +7,11 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <set>
 #include <thread>
 
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/datasets/dataset_specs.h"
 #include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/datasets/semantic_sources.h"
 #include "semsegmap/io/image_io.h"
@@ -538,6 +540,42 @@ TEST(FrontEndStages, APipelineLabelsAndRegistersItsFramesAsAWrappedSourceDoes) {
   ASSERT_TRUE(by_stages.labeling().has_value());
   EXPECT_EQ(by_stages.labeling()->network_runs,
             wrapped->size() * wrapped->info().rig.cameras.size());
+}
+
+// `train --config` with a semantics: section: the training runs are cut and described with the
+// network's classes instead of the simulator's. colour4 read through the Cityscapes map gives
+// four classes only, so no observation of its extraction holds a pole, a trunk or a tree.
+TEST(TrainingExtraction, TheNetworkOfTheOptionsLabelsTheTrainingRuns) {
+#if !SEMSEGMAP_WITH_SIM
+  GTEST_SKIP() << "needs the simulator (SEMSEGMAP_WITH_SIM=ON)";
+#endif
+  DatasetOptions options;
+  options.semantics = plainConfig();
+  options.semantics.class_map = (kClassMaps / "cityscapes.yaml").string();
+  options.semantics.replace_dataset_labels = true;
+  options.class_maps_dir = kClassMaps;
+  const ClassMap map = readClassMap(options.semantics.class_map, ClassTable::Default());
+  std::set<ClassId> network_classes = {cls::kUnknown};
+  for (int c = 0; c < 4; ++c) network_classes.insert(*map.find(c));
+  const std::vector<std::string> spec = {"sim:world=1,run=S1,preset=tiny,frames=12"};
+  ExtractionConfig extraction;
+  extraction.min_purity = 0.0f;
+  const TrainingSet perfect = extractTrainingSet(spec, PipelineConfig{}, extraction);
+  const TrainingSet labelled = extractTrainingSet(spec, PipelineConfig{}, extraction, {}, options);
+  auto classesOf = [](const TrainingSet& set) {
+    std::set<ClassId> seen;
+    for (const TrainingObservation& o : set.observations)
+      seen.insert(o.classes.begin(), o.classes.end());
+    return seen;
+  };
+  const std::set<ClassId> with_perfect = classesOf(perfect), with_network = classesOf(labelled);
+  ASSERT_FALSE(labelled.observations.empty());
+  EXPECT_TRUE(with_perfect.count(cls::kVegetation) || with_perfect.count(cls::kPole) ||
+              with_perfect.count(cls::kTrunk))
+      << "the simulator's labels of the run hold no thin objects or trees";
+  for (const ClassId c : with_network)
+    EXPECT_TRUE(network_classes.count(c)) << "class " << int(c) << " came from no network output";
+  EXPECT_GT(with_network.size(), 1u) << "no point took a network class";
 }
 
 TEST(SemanticsConfig, ReadFromTheConfigRelativeToIt) {

@@ -85,6 +85,9 @@ int runDemo(const CliArgs& a) {
             << (network.rate_hz > 0
                     ? ", at most " + std::to_string(network.rate_hz) + " pictures a second a camera"
                     : "")
+            << (config.label_passes.back().descriptor_model.empty()
+                    ? ""
+                    : ", SemSegMap's segments described by the descriptor trained on its labels")
             << ")\n";
   viz::writeSimOverview(sim::worldPreset(config.preset, config.world_seed), out / "overview.png");
   config.stop = stopToken();

@@ -285,9 +285,12 @@ const OptionSpec kLabelNoise{"label-noise", Value::kCount, "L", "0",
 const OptionSpec kLabels{
     "labels", Value::kText, "SPEC", "perfect",
     "camera labels: perfect (the simulator's), or network[,rate=R][,budget=C][,every]"
-    "[,ground=classes|geometry][,config=FILE]: the shipped segmentation network's on its "
+    "[,ground=classes|geometry][,descriptor=own][,config=FILE]: the shipped segmentation "
+    "network's on its "
     "budget, at R pictures a second per camera, within C cores, or on every picture, the ground "
-    "removed by class alone or by geometry too; several joined by + run on the same frames"};
+    "removed by class alone or by geometry too, SemSegMap described by the network file's "
+    "descriptor (trained on its labels) or its own (descriptor=own); several joined by + run on "
+    "the same frames"};
 const OptionSpec kRig{"rig", Value::kText, "KEYS", "",
                       "simulator keys for every run's rig, e.g. lidar=hdl64,cameras=front"};
 const OptionSpec kQueryOdometry{

@@ -9,11 +9,14 @@
 #include <sstream>
 
 #include "cli_args.h"
+#include "eval_args.h"
 #include "interrupt.h"
 #include "progress.h"
+#include "resources.h"
 #include "semsegmap/artefacts/model_file.h"
 #include "semsegmap/artefacts/training_cache.h"
 #include "semsegmap/core/atomic_file.h"
+#include "semsegmap/core/binary_io.h"
 #include "semsegmap/datasets/dataset_specs.h"
 #include "semsegmap/learn/smoothnet_trainer.h"
 #include "semsegmap/learn/trainer.h"
@@ -35,7 +38,7 @@ int positiveInt(const CliArgs& a, const std::string& name, int fallback) {
 // What the cached observations were made from: a different list, configuration or extraction
 // setting means extracting again.
 std::string provenance(const std::vector<std::string>& specs, const std::string& config_text,
-                       const ExtractionConfig& e) {
+                       const ExtractionConfig& e, const SemanticsConfig& network) {
   std::ostringstream s;
   s << "datasets:";
   for (const auto& spec : specs) s << ' ' << spec;
@@ -43,13 +46,20 @@ std::string provenance(const std::vector<std::string>& specs, const std::string&
     << "\nmax_points_per_observation: " << e.max_points_per_observation << "\nseed: " << e.seed
     << "\nconfig:\n"
     << config_text;
+  // A network retrained under the same file name labels otherwise: its bytes count too.
+  if (!network.model.empty()) {
+    const std::string model = readFileBytes(network.model);
+    s << "\nnetwork: " << std::hex << fnv1a64(model.data(), model.size()) << std::dec << " rate_hz "
+      << network.rate_hz << " budget_cores " << network.budget_cores << " latency_s "
+      << network.latency_s << " tolerance_s " << network.tolerance_s;
+  }
   return s.str();
 }
 
 TrainingSet loadOrExtract(const std::vector<std::string>& specs, const PipelineConfig& pipeline,
                           const std::string& config_text, const ExtractionConfig& extraction,
-                          const std::string& cache) {
-  const std::string made_from = provenance(specs, config_text, extraction);
+                          const DatasetOptions& options, const std::string& cache) {
+  const std::string made_from = provenance(specs, config_text, extraction, options.semantics);
   if (!cache.empty()) {
     if (auto set = readTrainingCache(cache, made_from)) {
       std::cout << "read " << set->observations.size() << " observations from " << cache << "\n";
@@ -61,13 +71,15 @@ TrainingSet loadOrExtract(const std::vector<std::string>& specs, const PipelineC
   std::unique_ptr<Progress> progress;
   size_t current = specs.size();
   TrainingSet set = extractTrainingSet(
-      specs, pipeline, extraction, [&](size_t done, size_t total, size_t dataset) {
+      specs, pipeline, extraction,
+      [&](size_t done, size_t total, size_t dataset) {
         if (dataset != current) {
           current = dataset;
           progress = std::make_unique<Progress>("extract " + specs[dataset], total);
         }
         progress->update(done);
-      });
+      },
+      options);
   if (set.interrupted) return set;  // a part of the data, never cached as the whole
   std::cout << "extracted " << set.observations.size() << " observations\n";
   if (!cache.empty()) {
@@ -246,7 +258,8 @@ int trainEnd(const CliArgs& a, const TrainConfig& config, const TrainResult& res
                              ", the best of the " + std::to_string(epochs) + " epochs done");
 }
 
-// The observations of --dataset (or --cache), with the pipeline of --config.
+// The observations of --dataset (or --cache), with the pipeline of --config and the camera
+// labels of --labels.
 TrainingSet trainingData(const CliArgs& a) {
   const std::vector<std::string> specs = splitDatasetSpecs(a.get("dataset"));
   ExtractionConfig extraction;
@@ -254,12 +267,26 @@ TrainingSet trainingData(const CliArgs& a) {
   // Without --config, the built-in defaults (those of config/semsegmap.yaml).
   PipelineConfig pipeline;
   std::string config_text = "(defaults)";
+  DatasetOptions options;
   if (a.has("config")) {
     pipeline = loadPipelineConfig(a.get("config"));
     config_text = readFileBytes(a.get("config"));
   }
+  // --labels network: the segmentation network's labels replace the simulator's perfect ones,
+  // within its budget, as in `eval localization --labels`: the descriptor learns the classes it
+  // will be given, errors included.
+  const LabelPass labels = labelPass(a.get("labels"));
+  if (!labels.network.model.empty()) {
+    options.semantics = labels.network;
+    options.semantics.replace_dataset_labels = true;  // the simulator's are perfect
+    options.class_maps_dir = shippedFile("config/class_maps");
+    if (labels.geometric_ground_removal) pipeline.local_map.geometric_ground_removal = true;
+    config_text += "\nlabels: " + labels.labels;
+    std::cout << "the runs' pictures labelled by " << labels.network.model
+              << " instead of the simulator's perfect labels\n";
+  }
   extraction.stop = stopToken();
-  return loadOrExtract(specs, pipeline, config_text, extraction,
+  return loadOrExtract(specs, pipeline, config_text, extraction, options,
                        a.has("cache") ? a.get("cache") : "");
 }
 
@@ -389,6 +416,10 @@ const CommandSpec& trainCommand() {
            "pipeline configuration that cuts the runs into segments (default: built-in, as "
            "config/semsegmap.yaml)"},
           maxFramesOption("stop each run after its first K frames, 0: all"),
+          {"labels", Value::kText, "SPEC", "perfect",
+           "camera labels of the runs: perfect (the simulator's) or network[,KEY=V...], a "
+           "segmentation network's as eval localization --labels reads it (network: the shipped "
+           "one, config/semantics-sim-network.yaml, at its budget)"},
           {"cache", Value::kText, "FILE", "",
            "read the observations from FILE if made from the same data and settings, else "
            "extract and write them there"},

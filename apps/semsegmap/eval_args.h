@@ -14,7 +14,8 @@ namespace semsegmap::app {
 std::vector<std::string> splitList(const std::string& s, char separator = ',');
 
 // One label pass of `eval localization --labels` (the demo's network pass too):
-// perfect | network[,rate=R][,budget=C][,every][,ground=classes|geometry][,config=FILE]. Throws
+// perfect | network[,rate=R][,budget=C][,every][,ground=classes|geometry][,descriptor=own]
+// [,config=FILE]. Throws
 // UsageError for a spec it cannot read.
 LabelPass labelPass(const std::string& spec);
 

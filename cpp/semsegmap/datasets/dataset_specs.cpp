@@ -10,14 +10,14 @@ namespace semsegmap {
 
 TrainingSet extractTrainingSet(const std::vector<std::string>& specs,
                                const PipelineConfig& pipeline, const ExtractionConfig& config,
-                               const ExtractionProgress& progress) {
+                               const ExtractionProgress& progress, const DatasetOptions& options) {
   if (specs.empty()) throw std::invalid_argument("no dataset to extract training data from");
   if (specs.size() > 0xffff) throw std::invalid_argument("too many datasets (at most 65535)");
   TrainingSet set;
   set.sources = specs;
   for (const auto& spec : specs) set.source_worlds.push_back(worldOf(spec));
   for (size_t i = 0; i < specs.size() && !set.interrupted; ++i) {
-    auto source = openDataset(specs[i]);
+    auto source = openDataset(specs[i], options);
     appendObservations(*source, static_cast<uint16_t>(i), pipeline, config, set, progress);
   }
   return set;

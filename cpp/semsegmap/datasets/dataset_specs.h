@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "semsegmap/datasets/open_dataset.h"
 #include "semsegmap/learn/training_data.h"
 
 namespace semsegmap {
@@ -13,11 +14,13 @@ namespace semsegmap {
 // itself for anything else (a dataset directory is a world of its own).
 std::string worldOf(const std::string& spec);
 
-// openDataset() on each spec, then appendObservations. Throws when a dataset has no ground-truth
-// poses or no point instances (nothing to learn from).
+// openDataset() on each spec (with `options`: a segmentation network in options.semantics labels
+// the pictures as a robot's would be), then appendObservations. Throws when a dataset has no
+// ground-truth poses or no point instances (nothing to learn from).
 TrainingSet extractTrainingSet(const std::vector<std::string>& specs,
                                const PipelineConfig& pipeline, const ExtractionConfig& config,
-                               const ExtractionProgress& progress = {});
+                               const ExtractionProgress& progress = {},
+                               const DatasetOptions& options = {});
 
 // A comma-separated list of dataset specs, where a sim spec has commas of its own: a token of
 // the form key=value (no '/' or ':') continues the sim: spec before it, any other token starts a

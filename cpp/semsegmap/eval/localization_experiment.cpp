@@ -21,6 +21,8 @@ namespace semsegmap {
 namespace {
 
 using PassLabelers = std::vector<std::unique_ptr<ReplayLabeler>>;
+// Indexed [pass][configuration]: a pass may describe with a model of its own (LabelPass).
+using PassDescribers = std::vector<std::vector<std::shared_ptr<Describer>>>;
 
 // Each pass's labeler: none for the simulator's labels; else its network, loaded and checked
 // against the run's cameras before any frame is read.
@@ -43,8 +45,11 @@ PassLabelers passLabelers(const LocalizationExperimentConfig& cfg, const Dataset
 std::vector<NamedConfig> passConfigs(const LocalizationExperimentConfig& cfg,
                                      const LabelPass& pass) {
   std::vector<NamedConfig> configs = cfg.configs;
-  if (pass.geometric_ground_removal)
-    for (NamedConfig& c : configs) c.config.local_map.geometric_ground_removal = true;
+  for (NamedConfig& c : configs) {
+    if (pass.geometric_ground_removal) c.config.local_map.geometric_ground_removal = true;
+    if (!pass.descriptor_model.empty() && c.config.descriptor.kind == pass.descriptor_kind)
+      c.config.descriptor.model = pass.descriptor_model;
+  }
   return configs;
 }
 
@@ -65,17 +70,18 @@ void feedPasses(const Frame& frame, const PassLabelers& labelers,
 // The map run, rendered once for every pass and configuration; each map is saved into
 // out/<pass dir>/maps/ (when interrupted, the map of the frames done: a whole map of a shorter
 // run). Indexed [pass][configuration].
-std::vector<std::vector<BuiltMap>> buildMaps(
-    LocalizationExperiment& e, const std::vector<std::shared_ptr<Describer>>& describers,
-    const std::filesystem::path& out, const ExperimentProgress& progress) {
+std::vector<std::vector<BuiltMap>> buildMaps(LocalizationExperiment& e,
+                                             const PassDescribers& describers,
+                                             const std::filesystem::path& out,
+                                             const ExperimentProgress& progress) {
   const LocalizationExperimentConfig& cfg = e.config;
   auto source = openDataset(simulatedRunSpec(cfg.world_seed, cfg.map_run, cfg.preset,
                                              cfg.max_frames, cfg.label_noise, cfg.rig));
   const PassLabelers labelers = passLabelers(cfg, source->info());
   std::vector<std::vector<std::unique_ptr<MappingSession>>> sessions;
-  for (const LabelPass& pass : cfg.label_passes)
-    sessions.push_back(mappingSessions(passConfigs(cfg, pass), source->info(), describers,
-                                       cfg.picture_points_per_segment));
+  for (size_t p = 0; p < cfg.label_passes.size(); ++p)
+    sessions.push_back(mappingSessions(passConfigs(cfg, cfg.label_passes[p]), source->info(),
+                                       describers[p], cfg.picture_points_per_segment));
   e.interrupted =
       !forEachFrame(*source, "map " + cfg.map_run, progress, cfg.stop, [&](const Frame& frame) {
         feedPasses(frame, labelers, [&](size_t p, const Frame& f) {
@@ -138,9 +144,8 @@ void writeRunFiles(const LocalizationExperimentConfig& cfg, const NamedConfig& c
 
 // One query run, rendered once for every pass and configuration.
 void localizeRun(LocalizationExperiment& e, const std::string& run_name,
-                 const std::vector<std::shared_ptr<Describer>>& describers,
-                 const std::vector<std::vector<BuiltMap>>& maps, const std::filesystem::path& out,
-                 const ExperimentProgress& progress) {
+                 const PassDescribers& describers, const std::vector<std::vector<BuiltMap>>& maps,
+                 const std::filesystem::path& out, const ExperimentProgress& progress) {
   const LocalizationExperimentConfig& cfg = e.config;
   DatasetOptions options;
   if (cfg.lidar_odometry) {
@@ -155,8 +160,8 @@ void localizeRun(LocalizationExperiment& e, const std::string& run_name,
   for (size_t p = 0; p < labelers.size(); ++p) {
     const std::vector<NamedConfig> configs = passConfigs(cfg, cfg.label_passes[p]);
     for (size_t c = 0; c < configs.size(); ++c)
-      sessions[p].push_back(std::make_unique<LocalizationSession>(configs[c].config, source->info(),
-                                                                  maps[p][c].map, describers[c]));
+      sessions[p].push_back(std::make_unique<LocalizationSession>(
+          configs[c].config, source->info(), maps[p][c].map, describers[p][c]));
   }
   e.interrupted =
       !forEachFrame(*source, "localize " + run_name, progress, cfg.stop, [&](const Frame& frame) {
@@ -264,8 +269,12 @@ LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& 
   for (const LabelPass& pass : cfg.label_passes)
     std::filesystem::create_directories(out / pass.dir / "maps");
   // Models load first: a missing one fails before minutes of simulation.
-  std::vector<std::shared_ptr<Describer>> describers;
-  for (const NamedConfig& c : cfg.configs) describers.push_back(makeDescriber(c.config.descriptor));
+  PassDescribers describers;
+  for (const LabelPass& pass : cfg.label_passes) {
+    describers.emplace_back();
+    for (const NamedConfig& c : passConfigs(cfg, pass))
+      describers.back().push_back(makeDescriber(c.config.descriptor));
+  }
   const std::vector<std::vector<BuiltMap>> maps = buildMaps(e, describers, out, progress);
   for (const std::string& run_name : cfg.query_runs) {
     if (e.interrupted) break;  // no run starts after the stop request
@@ -285,6 +294,8 @@ nlohmann::ordered_json toJson(const LocalizationExperiment& e) {
     nlohmann::ordered_json p = {{"labels", pass.labels},
                                 {"dir", pass.dir.string()},
                                 {"geometric_ground_removal", pass.geometric_ground_removal}};
+    if (!pass.descriptor_model.empty())
+      p["descriptor"] = {{"kind", pass.descriptor_kind}, {"model", pass.descriptor_model}};
     if (!pass.network.model.empty())
       p["network"] = {{"model", pass.network.model},
                       {"rate_hz", pass.network.rate_hz},

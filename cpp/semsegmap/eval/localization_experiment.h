@@ -25,6 +25,10 @@ struct LabelPass {
   // Every configuration of the pass removes the ground by geometry as well as by class
   // (local_map.geometric_ground_removal): what a network's labels need (its file says so).
   bool geometric_ground_removal = false;
+  // The learned descriptor trained on this network's labels (the network file's
+  // descriptor.model, of kind descriptor_kind): the pass's configurations of that kind describe
+  // with it instead of their own model, as a robot with this network would. Empty: their own.
+  std::string descriptor_kind, descriptor_model;
   std::filesystem::path dir;  // the pass's maps and runs, under the output folder ("": in it)
 };
 
