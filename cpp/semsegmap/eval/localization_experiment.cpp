@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -51,6 +52,23 @@ std::vector<NamedConfig> passConfigs(const LocalizationExperimentConfig& cfg,
       c.config.descriptor.model = pass.descriptor_model;
   }
   return configs;
+}
+
+// Each configuration's describer, loaded once and shared by the passes that describe with its
+// model; a pass with a model of its own (LabelPass::descriptor_model) gets that model's.
+PassDescribers passDescribers(const LocalizationExperimentConfig& cfg) {
+  std::map<std::pair<size_t, std::string>, std::shared_ptr<Describer>> loaded;
+  PassDescribers describers;
+  for (const LabelPass& pass : cfg.label_passes) {
+    const std::vector<NamedConfig> configs = passConfigs(cfg, pass);
+    describers.emplace_back();
+    for (size_t c = 0; c < configs.size(); ++c) {
+      std::shared_ptr<Describer>& describer = loaded[{c, configs[c].config.descriptor.model}];
+      if (!describer) describer = makeDescriber(configs[c].config.descriptor);
+      describers.back().push_back(describer);
+    }
+  }
+  return describers;
 }
 
 // Hands each pass its frame: the rendered one, or a copy that the pass's network labels.
@@ -269,12 +287,7 @@ LocalizationExperiment evaluateLocalization(const LocalizationExperimentConfig& 
   for (const LabelPass& pass : cfg.label_passes)
     std::filesystem::create_directories(out / pass.dir / "maps");
   // Models load first: a missing one fails before minutes of simulation.
-  PassDescribers describers;
-  for (const LabelPass& pass : cfg.label_passes) {
-    describers.emplace_back();
-    for (const NamedConfig& c : passConfigs(cfg, pass))
-      describers.back().push_back(makeDescriber(c.config.descriptor));
-  }
+  const PassDescribers describers = passDescribers(cfg);
   const std::vector<std::vector<BuiltMap>> maps = buildMaps(e, describers, out, progress);
   for (const std::string& run_name : cfg.query_runs) {
     if (e.interrupted) break;  // no run starts after the stop request
