@@ -7,6 +7,7 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <visualization_msgs/Marker.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
@@ -164,7 +165,12 @@ void NodeOutput::publishPose(const LivePose& p, double stamp_s, const NodeParams
   pose.pose.pose.orientation = t.rotation;
   const double var_m = params.position_sigma_m * params.position_sigma_m;
   const double sigma_rad = params.rotation_sigma_deg * M_PI / 180.0;
-  for (int k = 0; k < 6; ++k) pose.pose.covariance[k * 7] = k < 3 ? var_m : sigma_rad * sigma_rad;
+  // The estimate's own covariance (ROS order already), each variance at least the floor's.
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) pose.pose.covariance[i * 6 + j] = p.record.covariance(i, j);
+  for (int k = 0; k < 6; ++k)
+    pose.pose.covariance[k * 7] =
+        std::max(pose.pose.covariance[k * 7], k < 3 ? var_m : sigma_rad * sigma_rad);
   pose_.publish(pose);
   publishMatches(p, stamp_s, params.map_frame);
 }

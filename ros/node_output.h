@@ -26,8 +26,8 @@ struct NodeParams {
   std::string map_frame = "map";
   bool relocalize = false;    // localization.relocalization.enabled, as localize --relocalize
   int max_queued_frames = 2;  // frames waiting for the pipeline; more drops the oldest
-  // The covariance of a published pose: a configured constant (the localization gives no
-  // covariance of its own), position and rotation standard deviations.
+  // Floors under a published pose's covariance, which the localization estimates from its own
+  // evidence (localize/pose_covariance.h): position and rotation standard deviations.
   double position_sigma_m = 0.1;
   double rotation_sigma_deg = 1.0;
 };

@@ -556,8 +556,10 @@ def wake_ups_table(inputs):
     frames = max(e.get("wake_up_frames") or WAKE_UP_BY[-1] for _, _, e in loaded)
     by_frame = [k for k in WAKE_UP_BY if k <= frames]
     header = (rig + [("config", 0), ("method", 0), ("wake-ups at a revisit", 1)] +
-              [(f"by frame {k}", 1) for k in by_frame] + [("first localization wrong", 1),
-                                                          ("ms / query", 1)])
+              [(f"by frame {k}", 1) for k in by_frame] +
+              [("first localization wrong", 1), ("wrong poses, any wake-up", 1),
+               ("ambiguous", 1), ("within 3 sigma", 1), ("mean NEES", 1), ("median sigma", 1),
+               ("ms / query", 1)])
     rows = []
     for label, path, e in loaded:
         for r in e["results"]:
@@ -569,8 +571,19 @@ def wake_ups_table(inputs):
             wrong = sum(1 for w in r["wake_ups"] if w["wrong_first"])
             rows.append(([label] if rig else []) +
                         [r["config"], revisit_method(r), len(at_revisit), *by, wrong,
+                         r["n_wrong"], r.get("n_ambiguous", "-"), *calibration_cells(r),
                          ms_per_query(r)])
     return table(header, rows)
+
+
+def calibration_cells(r):
+    """The share within 3 sigma, the mean NEES and the median sigma of a result's poses."""
+    c = r.get("covariance_calibration") or {}
+    share, nees, sigma = (c.get(k) for k in ("share_mahalanobis_within_3", "mean_nees",
+                                             "median_sigma_m"))
+    return (f"{100 * share:.0f} %" if share is not None else "-",
+            f"{nees:.2f}" if nees is not None else "-",
+            f"{sigma:.2f} m" if sigma is not None else "-")
 
 
 # The registrations the odometry was chosen among (bench/bench_odometry.cpp), in table order.

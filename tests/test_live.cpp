@@ -185,9 +185,9 @@ struct SlowProcess {
     return [this](const Frame& f) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       seen.push_back(f.timestamp_s);
-      LivePose p;
-      p.record.frame_index = f.index;
-      return std::vector<LivePose>{p};
+      std::vector<LivePose> poses(1);
+      poses[0].record.frame_index = f.index;
+      return poses;
     };
   }
 };

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <random>
 
@@ -231,7 +232,8 @@ TEST(Modes, ScansFarApartLocalizeFromTheLatestScanWhenTheLocalMapDoesNot) {
 // localization.relocalization: a robot wakes up (one scan of S2) in a map of S1. The whole-map
 // query is made to ask for more consistent matches than one scan gives, so only the
 // relocalization path (places voted for, fewer inliers, the registration check) can localize it;
-// a map without segment points is refused before any frame, and a prior elsewhere finds nothing.
+// a map without segment points still localizes with relocalization off, saying so in one line,
+// and a prior elsewhere finds nothing.
 TEST(Modes, AWakeUpIsRelocalizedFromOneScanAndThePathIsRecorded) {
   SEMSEGMAP_SKIP_WITHOUT_SIM();
   PipelineConfig config = semsegmapConfig();
@@ -271,14 +273,37 @@ TEST(Modes, AWakeUpIsRelocalizedFromOneScanAndThePathIsRecorded) {
       runLocalization(wake_up, config, map, describer, {}, MapSettingsCheck::kRefuse, elsewhere)
           .localizations.empty());
 
-  TargetMap bare = *map;
-  for (MapSegment& s : bare.segments) s.points.clear();
-  bare.source = "bare.map";
-  const std::string error = test_support::errorOf([&] {
-    runLocalization(wake_up, config, std::make_shared<const TargetMap>(bare), describer);
-  });
-  EXPECT_MENTIONS(error, "bare.map: stores no segment points, which localization.relocalization");
-  EXPECT_ONE_LINE(error);
+  // The pose's covariance comes from the registration: finite, no looser than its floors, and
+  // the robot's true position within three of its sigmas.
+  const Eigen::Matrix<double, 6, 1> sigmas = sigmasOf(r.covariance);
+  EXPECT_TRUE(sigmas.allFinite());
+  EXPECT_GE(sigmas[0], config.localization.covariance.min_sigma_m);
+  EXPECT_LT(sigmas.head<2>().maxCoeff(), 1.0) << sigmas.transpose();
+  EXPECT_LE(positionNees(r.covariance, r.T_map_base.translation() - r.T_world_base->translation()),
+            9.0);
+
+  for (const size_t points : {size_t{0}, size_t{32}}) {
+    TargetMap few = *map;
+    for (MapSegment& s : few.segments) s.points = subsamplePoints(s.points, points);
+    if (points == 0)
+      for (MapSegment& s : few.segments) s.points.clear();
+    few.source = "few.map";
+    std::vector<std::string> notes;
+    setMessageSink([&](const std::string& line) { notes.push_back(line); });
+    config.localization.localizer.verification.min_inliers = 6;
+    config.localization.refinement.enabled = false;
+    std::vector<size_t> frames(20);
+    std::iota(frames.begin(), frames.end(), size_t{10});
+    FrameSubset drive(*run, frames);
+    const LocalizationRun run_few =
+        runLocalization(drive, config, std::make_shared<const TargetMap>(few), describer);
+    setMessageSink({});
+    EXPECT_FALSE(run_few.localizations.empty()) << "it still localizes";
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_MENTIONS(notes[0], "few.map: keeps ");
+    EXPECT_MENTIONS(notes[0], "relocalization is off for this run; rebuild the map with");
+    config.localization.localizer.verification.min_inliers = 1000;
+  }
 }
 
 // localization.relocalization.scan_context: a map with segment points and
@@ -386,7 +411,7 @@ TEST(Modes, SummaryWithoutGroundTruthHasNullCountsAndErrors) {
   r.inliers = 7;
   run.localizations.assign(2, r);
   const std::string json = localizationSummaryJson(run, SummaryContext{});
-  EXPECT_NE(json.find("\"schema\": \"semsegmap.localization/3\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"schema\": \"semsegmap.localization/4\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"n_localizations\": 2"), std::string::npos) << json;
   EXPECT_NE(json.find("\"n_with_ground_truth\": 0"), std::string::npos) << json;
   for (const char* key : {"n_error_below_1m", "n_error_below_5m", "mean_translation_error_m",

@@ -11,6 +11,7 @@
 
 #include "semsegmap/core/pose.h"
 #include "semsegmap/core/random.h"
+#include "semsegmap/localize/pose_covariance.h"
 #include "semsegmap/localize/registration_check.h"
 #include "semsegmap/localize/relocalizer.h"
 #include "synthetic_town.h"
@@ -84,8 +85,11 @@ TEST(Relocalizer, FindsTheRobotFromOneScanWhereTheWholeMapQueryDoesNot) {
       const auto r =
           relocalize(localizer, q.centroids, q.descriptors, q.points, q.robot_local, config);
       if (!r) continue;
-      // Never wrong: a pose it gives is the registered one.
+      // Never wrong: a pose it gives is the registered one, and a town of random buildings has
+      // no look-alike place.
       EXPECT_LT((r->match.T_map_local * q.robot_local - robot).norm(), 0.2);
+      EXPECT_FALSE(r->ambiguous) << "runner-up " << r->runner_up_fitness << " against "
+                                 << r->check.fitness;
       EXPECT_GE(r->check.fitness, config.check.min_fitness);
       ++relocalized;
     }
@@ -126,6 +130,94 @@ TEST(Relocalizer, RefusesAPlaceWhoseSegmentsMatchButWhosePointsDoNot) {
   const auto match = after.localize(q.centroids, q.descriptors);
   ASSERT_TRUE(match) << "the moved segments are meant to match as a whole";
   EXPECT_FALSE(relocalize(after, q.centroids, q.descriptors, q.points, q.robot_local, {}));
+}
+
+// A scan of one long wall: the registration pins the pose across the wall and leaves it free
+// along it, and the covariance says so, large but finite along the wall.
+TEST(RegistrationCheck, AScanOfOneWallIsUncertainAlongIt) {
+  const Eigen::Vector3d along(std::cos(0.5), std::sin(0.5), 0), across(-along.y(), along.x(), 0);
+  SeededRng rng(21);
+  // The wall as eight segments of 5 m (the check takes a limited number of points a segment).
+  auto wall = [&](double spacing_m) {
+    std::vector<Points> out(8);
+    for (double s = -20; s < 20; s += spacing_m)
+      for (double z = 0; z <= 6; z += spacing_m)
+        out[static_cast<size_t>((s + 20) / 5)].push_back(
+            (s * along + Eigen::Vector3d(0, 0, z) + across * rng.gaussian(0.01)).cast<float>());
+    return out;
+  };
+  TargetMap map;
+  map.descriptor = "eigen";
+  for (const Points& part : wall(0.25)) {
+    MapSegment segment;
+    segment.points = part;
+    for (const Eigen::Vector3f& p : part) segment.centroid += p / static_cast<float>(part.size());
+    segment.n_points = static_cast<uint32_t>(part.size());
+    map.segments.push_back(segment);
+  }
+  map.descriptors = Eigen::MatrixXf::Zero(static_cast<Eigen::Index>(map.size()), 4);
+  const Pose T = someLocalFrame();
+  const Pose T_local_map = T.inverse();
+  std::vector<Points> local;
+  for (const Points& part : wall(0.3)) {
+    local.emplace_back();
+    for (const Eigen::Vector3f& p : part)
+      local.back().push_back((T_local_map * p.cast<double>()).cast<float>());
+  }
+  const Eigen::Vector3d robot_map = 8.0 * across + Eigen::Vector3d(0, 0, 1.5);
+  const RegistrationCheck c =
+      checkRegistration(local, T_local_map * robot_map, map, T, RegistrationCheckConfig{});
+  ASSERT_TRUE(c.accepted) << c.reason;
+  const PoseCovarianceConfig config;
+  const Covariance6 P =
+      covarianceFromEvidence(c.evidence, robot_map, config.registration_inflation, config);
+  ASSERT_TRUE(P.allFinite());
+  const Eigen::Matrix3d position = P.topLeftCorner<3, 3>();
+  const double sigma_along = std::sqrt(along.dot(position * along));
+  const double sigma_across = std::sqrt(across.dot(position * across));
+  EXPECT_GT(sigma_along, 10.0) << "across " << sigma_across;
+  EXPECT_LE(sigma_along, config.max_sigma_m * 1.01);
+  EXPECT_LT(sigma_across, 0.5);
+  EXPECT_GE(sigma_across, config.min_sigma_m);
+}
+
+// A straight street of alike houses, every 16 m on both sides, alike descriptors: a scan in the
+// middle registers as well one house further on. The relocalization gives no pose, or one marked
+// ambiguous, never a plain one.
+TEST(Relocalizer, AStraightStreetOfAlikeHousesGivesNoPoseOrAnAmbiguousOne) {
+  Town street;
+  SeededRng rng(31);
+  street.map.descriptor = "eigen";
+  std::vector<Eigen::VectorXf> rows;
+  const Eigen::VectorXf house = Eigen::VectorXf::Constant(16, 1.0f);
+  for (int i = 0; i < 40; ++i)
+    for (const float side : {-12.0f, 12.0f}) {
+      const Building b{Eigen::Vector3f(16.0f * static_cast<float>(i), side, 0),
+                       Eigen::Vector3f(10, 8, 6)};
+      street.buildings.push_back(b);
+      MapSegment s;
+      s.points = wallsOf(b, rng, 0.5);
+      s.centroid = b.centre + Eigen::Vector3f(0, 0, 3);
+      s.n_points = static_cast<uint32_t>(s.points.size());
+      street.map.segments.push_back(s);
+      rows.push_back(house);
+    }
+  street.map.descriptors.resize(static_cast<Eigen::Index>(rows.size()), 16);
+  for (size_t i = 0; i < rows.size(); ++i)
+    street.map.descriptors.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  const Localizer localizer(street.map, wholeMapLocalizer());
+  const Pose T = someLocalFrame();
+  const Eigen::Vector3d robot(16.0 * 20 + 5, 0, 0);
+  const Query q = queryAt(street, robot, T, 45, 0.05, 32);
+  ASSERT_GE(q.centroids.size(), 8u);
+  const auto r = relocalize(localizer, q.centroids, q.descriptors, q.points, q.robot_local,
+                            RelocalizationConfig{});
+  if (r) {
+    EXPECT_TRUE(r->ambiguous) << "a pose " << (r->match.T_map_local * q.robot_local - robot).norm()
+                              << " m from the robot, fitness " << r->check.fitness << ", runner-up "
+                              << r->runner_up_fitness;
+    EXPECT_GT(r->runner_up_fitness, 0.0);
+  }
 }
 
 TEST(Relocalizer, APriorRestrictsThePlaces) {
@@ -203,6 +295,75 @@ TEST(Relocalizer, TheMapsScanContextsCorroborateOnlyAPoseThatAgreesWithThem) {
   corroborate(c, t.map, t.scan, config);
   EXPECT_TRUE(c.accepted);
   EXPECT_TRUE(c.reason.empty());
+}
+
+// A scan context cannot corroborate its own proposal. The robot stands where the map holds
+// nothing; somewhere else half of its buildings stand as it sees them (with other descriptors,
+// so the segments vote for nothing there), and the map's scan contexts along that street are the
+// scan's own. That place registers at about half the points: below min_fitness, above what
+// corroboration would accept. The scan context proposed it, so nothing may corroborate it but
+// other evidence, and there is none: no pose.
+TEST(Relocalizer, AScanContextsOwnWrongProposalBelowTheFitnessIsRefused) {
+  Town town = makeTown(2000, 1000, 41);
+  const Eigen::Vector3d robot(500, 500, 0);
+  const Pose T = someLocalFrame();
+  const Query q = queryAt(town, robot, T, 45, 0.3, 42);
+  ASSERT_GE(q.centroids.size(), 8u);
+  // The query's buildings, in its order (queryAt), copied until they hold 45 % of its points.
+  size_t total = 0;
+  for (const Points& p : q.points) total += p.size();
+  std::vector<bool> copy(town.map.size(), false);
+  size_t k = 0, copied_points = 0;
+  for (size_t i = 0; i < town.buildings.size(); ++i) {
+    if ((town.buildings[i].centre.head<2>().cast<double>() - robot.head<2>()).norm() > 45) continue;
+    if (copied_points < total * 45 / 100) {
+      copy[i] = true;
+      copied_points += q.points[k].size();
+    }
+    ++k;
+  }
+  SeededRng rng(43);
+  const Eigen::Vector3f offset(900, -700, 0);
+  int copied = 0;
+  for (size_t i = 0; i < town.map.size(); ++i) {
+    MapSegment& s = town.map.segments[i];
+    if ((s.centroid.head<2>().cast<double>() - robot.head<2>()).norm() > 100) continue;
+    const Eigen::Vector3f to = copy[i] ? offset : Eigen::Vector3f(-3000, 4000, 0);
+    s.centroid += to;
+    for (Eigen::Vector3f& p : s.points) p += to;
+    if (!copy[i]) continue;
+    // Far from every query descriptor: never among a local segment's nearest, no vote.
+    for (Eigen::Index d = 0; d < town.map.descriptors.cols(); ++d)
+      town.map.descriptors(static_cast<Eigen::Index>(i), d) =
+          100.0f + static_cast<float>(rng.gaussian(1));
+    ++copied;
+  }
+  ASSERT_GE(copied, 4);
+  const Pose wrong = Eigen::Translation3d(offset.cast<double>()) * T;
+  // The scan context there is the scan's own, and so is one 30 m on: a straight road looks the
+  // same along it, so neither is distinct (scan_context_distinct_ratio).
+  const TurnedScan own = turnedScan(0);
+  ScanContextQuery scan = own.scan;
+  town.map.scan_contexts.add(own.scan.context, wrong * scan.T_local_scan);
+  town.map.scan_contexts.add(own.scan.context,
+                             Eigen::Translation3d(30, 0, 0) * wrong * scan.T_local_scan);
+  const RelocalizationConfig config;
+  // The place as the scan context proposes it: half on the map's points, corroborated by
+  // itself.
+  const RegistrationCheck there =
+      checkRegistration(q.points, q.robot_local, town.map, wrong, config.check);
+  ASSERT_FALSE(there.accepted);
+  ASSERT_GE(there.fitness, config.scan_context_min_fitness) << there.reason;
+  ASSERT_LT(there.fitness, config.check.min_fitness);
+  ASSERT_TRUE(scanContextAgrees(town.map, scan, there.T_map_local, config));
+
+  const Localizer localizer(town.map, wholeMapLocalizer());
+  const auto r = relocalize(localizer, q.centroids, q.descriptors, q.points, q.robot_local, config,
+                            std::nullopt, scan);
+  EXPECT_FALSE(r) << "a pose " << (r->match.T_map_local * q.robot_local - robot).norm()
+                  << " m from the robot, fitness " << r->check.fitness << " sc "
+                  << r->by_scan_context << " d " << r->scan_context_distance << " rival "
+                  << r->scan_context_rival;
 }
 
 TEST(Relocalizer, RefusesMismatchedInput) {

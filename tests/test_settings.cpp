@@ -65,8 +65,11 @@ SettingValue otherValue(const Setting& s) {
       const long long v = std::get<long long>(d);
       return v + 1 <= s.hi ? v + 1 : v - 1;
     }
-    case SettingKind::kNumber:
-      return std::get<double>(d) + 0.125;
+    case SettingKind::kNumber: {
+      // A share whose default lies near 1 (ambiguity_ratio) stays a share.
+      const double v = std::get<double>(d);
+      return v > 0.875 && v <= 1.0 ? v - 0.125 : v + 0.125;
+    }
     // Absolute, so that it is not taken relative to the config file.
     case SettingKind::kText:
       return "/elsewhere/" + s.key;

@@ -261,6 +261,19 @@ class RelocalizationConfig:
     scan_context_max_distance: float
     scan_context_candidates: int
     scan_context_min_fitness: float
+    scan_context_distinct_ratio: float
+    ambiguity_ratio: float
+    def __init__(self, **fields: object) -> None: ...
+
+class PoseCovarianceConfig:
+    _fields: tuple[str, ...]
+    registration_inflation: float
+    centroid_inflation: float
+    min_sigma_m: float
+    min_sigma_deg: float
+    max_sigma_m: float
+    max_sigma_deg: float
+    degeneracy_ratio: float
     def __init__(self, **fields: object) -> None: ...
 
 class LocalizationConfig:
@@ -270,6 +283,7 @@ class LocalizationConfig:
     latest_scan_fallback_m: float
     refinement: RefinementConfig
     relocalization: RelocalizationConfig
+    covariance: PoseCovarianceConfig
     def __init__(self, **fields: object) -> None: ...
 
 class TargetMapBuilderConfig:
@@ -614,6 +628,10 @@ class LocalizationRecord:
     def path(self) -> str: ...
     @property
     def registration_fitness(self) -> Optional[float]: ...
+    @property
+    def covariance(self) -> _F64: ...
+    @property
+    def status(self) -> str: ...
 
 class LocalizationSummary:
     def __repr__(self) -> str: ...

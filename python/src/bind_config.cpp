@@ -114,13 +114,25 @@ void bindLocalizationConfigs(py::module_& m) {
       .field("scan_context", &RL::scan_context)
       .field("scan_context_max_distance", &RL::scan_context_max_distance)
       .field("scan_context_candidates", &RL::scan_context_candidates)
-      .field("scan_context_min_fitness", &RL::scan_context_min_fitness);
+      .field("scan_context_min_fitness", &RL::scan_context_min_fitness)
+      .field("scan_context_distinct_ratio", &RL::scan_context_distinct_ratio)
+      .field("ambiguity_ratio", &RL::ambiguity_ratio);
+  using PC = PoseCovarianceConfig;
+  StructBinding<PC>(m, "PoseCovarianceConfig", "localize/pose_covariance.h")
+      .field("registration_inflation", &PC::registration_inflation)
+      .field("centroid_inflation", &PC::centroid_inflation)
+      .field("min_sigma_m", &PC::min_sigma_m)
+      .field("min_sigma_deg", &PC::min_sigma_deg)
+      .field("max_sigma_m", &PC::max_sigma_m)
+      .field("max_sigma_deg", &PC::max_sigma_deg)
+      .field("degeneracy_ratio", &PC::degeneracy_ratio);
   StructBinding<LocalizationConfig>(m, "LocalizationConfig", "pipeline/pipeline_config.h")
       .field("localizer", &LocalizationConfig::localizer)
       .field("every_n_frames", &LocalizationConfig::every_n_frames)
       .field("latest_scan_fallback_m", &LocalizationConfig::latest_scan_fallback_m)
       .field("refinement", &LocalizationConfig::refinement)
-      .field("relocalization", &LocalizationConfig::relocalization);
+      .field("relocalization", &LocalizationConfig::relocalization)
+      .field("covariance", &LocalizationConfig::covariance);
   using TMB = TargetMapBuilderConfig;
   StructBinding<TMB>(m, "TargetMapBuilderConfig", "localize/target_map.h")
       .field("duplicate_distance_m", &TMB::duplicate_distance_m)

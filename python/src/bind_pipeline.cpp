@@ -406,7 +406,23 @@ void bindLocalizationRecord(py::module_& m) {
       .def_readonly(
           "registration_fitness", &LocalizationRecord::registration_fitness,
           "the registration check's share of local points on the map's (a relocalization, or "
-          "any pose while lost); None otherwise");
+          "any pose while lost); None otherwise")
+      .def_property_readonly(
+          "covariance",
+          [](const LocalizationRecord& r) {
+            py::array_t<double> a({size_t{6}, size_t{6}});
+            auto v = a.mutable_unchecked<2>();
+            for (py::ssize_t i = 0; i < 6; ++i)
+              for (py::ssize_t j = 0; j < 6; ++j) v(i, j) = r.covariance(i, j);
+            return a;
+          },
+          "(6, 6) float64: the pose's covariance from its own evidence, in the map frame, ROS "
+          "order (x, y, z, roll, pitch, yaw; m^2, rad^2)")
+      .def_property_readonly(
+          "status",
+          [](const LocalizationRecord& r) { return r.ambiguous ? "ambiguous" : "localized"; },
+          "'localized', or 'ambiguous': the scan fits another place as well (never a pose to "
+          "use; not among a run's localizations)");
 }
 
 void bindLocalizationResults(py::module_& m) {

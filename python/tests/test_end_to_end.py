@@ -133,6 +133,14 @@ def test_one_scan_is_relocalized_by_the_command_line_and_python_alike(binary, tm
     np.testing.assert_allclose([float(rows[0][k]) for k in "xyz"], record.T_map_base[:3, 3],
                                atol=2e-4)
     assert record.registration_fitness == pytest.approx(float(rows[0]["fitness"]), abs=1e-3)
+    # Its covariance, from the registration's evidence, as the command line wrote it.
+    assert record.status == "localized" and rows[0]["status"] == "localized"
+    assert record.covariance.shape == (6, 6) and np.all(np.isfinite(record.covariance))
+    np.testing.assert_allclose(record.covariance, record.covariance.T)
+    sigmas = np.sqrt(np.diag(record.covariance))
+    np.testing.assert_allclose(sigmas[:3], [float(rows[0][f"sigma_{a}_m"]) for a in "xyz"],
+                               rtol=1e-3, atol=1e-4)
+    assert sigmas[0] >= config.localization.covariance.min_sigma_m
     assert session.run.localizations == []
     assert record.translation_error_m < 0.3
     # The scan as arrays: its own frame is the local map's (no odometry, no ground truth), so its

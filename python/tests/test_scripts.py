@@ -292,8 +292,20 @@ def test_revisit_tables_say_which_method_gave_each_row_and_its_time(tmp_path):
     assert rows[4].endswith("| 180.0 |"), rows[4]
     rows = write_table(tmp_path, "wake-ups", [str(path)])
     assert rows[0].startswith("| config | method | wake-ups at a revisit | by frame 1 |"), rows[0]
+    # Older files have no ambiguous count and no covariances: "-".
     assert rows[4] == ("| scan-context | Scan Context (whole scan) | 2 | 0 | 1 | 1 | 1 | 1 | 1 "
-                       "| 180.0 |")
+                       "| 0 | - | - | - | - | 180.0 |")
+    # A file with them: the wrong poses of any wake-up, the ambiguous ones and the calibration.
+    with_covariances = revisit_result("semsegmap", "segments", "semsegmap-net", wake_ups, 41.25)
+    with_covariances.update({"n_wrong": 2, "n_ambiguous": 3, "covariance_calibration": {
+        "share_mahalanobis_within_3": 0.962, "mean_nees": 2.514, "median_sigma_m": 0.123}})
+    path.write_text(json.dumps({"n_revisits": 4, "results": [with_covariances]}))
+    rows = write_table(tmp_path, "wake-ups", [str(path)])
+    assert rows[2] == ("| semsegmap | segments (semsegmap-net) | 2 | 0 | 1 | 1 | 1 | 1 | 1 "
+                       "| 2 | 3 | 96 % | 2.51 | 0.12 m | 41.2 |"), rows[2]
+    path.write_text(json.dumps({"n_revisits": 4, "results": [
+        revisit_result("semsegmap", "segments", "semsegmap-net", wake_ups, 41.25), older,
+        revisit_result("scan-context", "scan-context", "scan-context", wake_ups, 180.0)]}))
     # One file per rig, each labelled: a first column names the rig.
     rows = write_table(tmp_path, "wake-ups", [f"paper={path}", f"HDL-64E={path}"])
     assert rows[0].startswith("| rig | config | method | wake-ups at a revisit |"), rows[0]
@@ -304,7 +316,8 @@ def test_revisit_tables_say_which_method_gave_each_row_and_its_time(tmp_path):
         revisit_result("semsegmap", "segments", "semsegmap-net", wake_ups, 41.25)]}))
     rows = write_table(tmp_path, "wake-ups", [str(path)])
     assert "| by frame 1 | first localization wrong |" in rows[0], rows[0]
-    assert rows[2] == "| semsegmap | segments (semsegmap-net) | 2 | 0 | 1 | 41.2 |", rows[2]
+    assert rows[2] == ("| semsegmap | segments (semsegmap-net) | 2 | 0 | 1 | 0 | - | - | - | - "
+                       "| 41.2 |"), rows[2]
 
 
 def documented_writes():

@@ -53,7 +53,8 @@ def published(path):
                 poses.append((msg.header.stamp.to_sec(),
                               matrix([p.position.x, p.position.y, p.position.z],
                                      [p.orientation.x, p.orientation.y, p.orientation.z,
-                                      p.orientation.w])))
+                                      p.orientation.w]),
+                              np.array(msg.pose.covariance).reshape(6, 6)))
             else:
                 for t in msg.transforms:
                     key = (t.header.frame_id, t.child_frame_id, round(t.header.stamp.to_sec(), 6))
@@ -65,7 +66,8 @@ def offline(path):
     with open(path, encoding="utf-8") as f:
         return [(float(r["timestamp"]),
                  matrix([float(r["x"]), float(r["y"]), float(r["z"])],
-                        [float(r["qx"]), float(r["qy"]), float(r["qz"]), float(r["qw"])]))
+                        [float(r["qx"]), float(r["qy"]), float(r["qz"]), float(r["qw"])]),
+                 np.array([float(r[f"sigma_{a}_m"]) for a in "xyz"]))
                 for r in csv.DictReader(f) if r["x"]]
 
 
@@ -86,7 +88,11 @@ def main():
     print(f"localized: {len(poses)} live, {len(expected)} offline")
     assert len(expected) > 0, "the offline run localized nothing to compare with"
     assert len(poses) == len(expected), "as many localizations as the offline run"
-    for (t, live), (t_off, off) in zip(poses, expected):
+    for (t, live, covariance), (t_off, off, sigmas) in zip(poses, expected):
+        # The pose's own covariance, each variance at least the node's floor (0.1 m by default).
+        assert np.all(np.isfinite(covariance)), f"covariance at {t}"
+        np.testing.assert_allclose(np.sqrt(np.diag(covariance)[:3]), np.maximum(sigmas, 0.1),
+                                   rtol=1e-3, atol=1e-4, err_msg=f"covariance at {t}")
         assert abs(t - t_off) < 1e-4, f"pose at {t}, offline at {t_off}"
         assert np.linalg.norm(live[:3, 3] - off[:3, 3]) < 0.01, f"pose at {t} off the offline one"
         assert degrees_between(live, off) < 0.1, f"pose at {t} turned from the offline one"

@@ -177,6 +177,10 @@ RevisitResult resultOf(const RevisitExperiment& e, const std::string& name,
   const LocalizationSummary s = summarize(run.localizations);
   r.mean_translation_error_m = s.mean_translation_error_m;
   r.mean_rotation_error_deg = s.mean_rotation_error_deg;
+  r.ambiguous = run.ambiguous.size();
+  r.share_mahalanobis_within_3 = s.share_mahalanobis_within_3;
+  r.mean_nees = s.mean_nees;
+  r.median_sigma_m = s.median_sigma_m;
   if (run.stats.frames > 0)
     r.ms_per_query = run.stats.total.total() / static_cast<double>(run.stats.frames);
   return r;
@@ -269,6 +273,8 @@ void localizeByScanContext(const ScanContextLocalizer& scan_context, const Frame
 RevisitResult scanContextResultOf(const RevisitExperiment& e, const LocalizationRun& run,
                                   const ScanContextLocalizer& scan_context) {
   RevisitResult r = resultOf(e, kScanContextName, run);
+  // Scan Context's poses carry no covariance of their own.
+  r.share_mahalanobis_within_3 = r.mean_nees = r.median_sigma_m = std::nullopt;
   r.method = kScanContextName;
   r.descriptor = kScanContextName;
   r.mapped_scans = scan_context.size();
@@ -292,6 +298,7 @@ void writeScanContextFiles(const LocalizationRun& run, const RevisitResult& r,
 
 void appendRun(LocalizationRun& all, LocalizationRun run) {
   for (LocalizationRecord& l : run.localizations) all.localizations.push_back(std::move(l));
+  for (LocalizationRecord& l : run.ambiguous) all.ambiguous.push_back(std::move(l));
   all.trajectory_gt.insert(all.trajectory_gt.end(), run.trajectory_gt.begin(),
                            run.trajectory_gt.end());
   all.trajectory_odom.insert(all.trajectory_odom.end(), run.trajectory_odom.begin(),
@@ -389,6 +396,11 @@ nlohmann::ordered_json toJson(const RevisitResult& r) {
           {"n_error_below_1m", r.below_1m},
           {"n_error_below_5m", r.below_5m},
           {"n_wrong", r.wrong},
+          {"n_ambiguous", r.ambiguous},
+          {"covariance_calibration",
+           {{"share_mahalanobis_within_3", orNull(r.share_mahalanobis_within_3)},
+            {"mean_nees", orNull(r.mean_nees)},
+            {"median_sigma_m", orNull(r.median_sigma_m)}}},
           {"mean_translation_error_m", orNull(r.mean_translation_error_m)},
           {"mean_rotation_error_deg", orNull(r.mean_rotation_error_deg)},
           {"n_revisits_localized", r.revisits_localized},

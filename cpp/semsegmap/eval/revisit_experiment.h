@@ -106,7 +106,10 @@ struct RevisitResult {  // one configuration, or Scan Context
   size_t below_0_5m = 0, below_1m = 0, below_5m = 0, wrong = 0;
   std::optional<double> mean_translation_error_m, mean_rotation_error_deg;  // none: unknown
   size_t revisits_localized = 0;  // revisit frames localized within correct_m
-  std::vector<WakeUp> wake_ups;   // with wake-ups only
+  size_t ambiguous = 0;           // relocalizations that fit another place too: no pose
+  // The covariances against the errors (LocalizationSummary): none without a localization.
+  std::optional<double> share_mahalanobis_within_3, mean_nees, median_sigma_m;
+  std::vector<WakeUp> wake_ups;  // with wake-ups only
   // check_ground_truth: localizations with a registered ground truth, and their errors to it.
   size_t registered_compared = 0;
   size_t registered_below_0_3m = 0;  // and 1 degree: the real-data target

@@ -116,6 +116,7 @@ Refinement refinePose(const Localization& match,
   r.correction_m = (icp.T.translation() - at_centroid.translation()).norm();
   if (r.correction_m > config.max_correction_m)
     return notApplied(match, "the points disagree with the match");
+  r.evidence = evidenceAt(source, target, icp.T, config.fine_distance_m, config.kernel_scale_m);
   r.applied = true;
   return r;
 }

@@ -14,6 +14,7 @@
 
 #include "semsegmap/localize/localizer.h"
 #include "semsegmap/localize/target_map.h"
+#include "semsegmap/odometry/icp.h"
 
 namespace semsegmap {
 
@@ -44,6 +45,8 @@ struct Refinement {
   size_t correspondences = 0;
   double correction_m = 0.0;  // how far the refinement moved the local map's origin
   std::string reason;         // why it was not applied ("" when applied)
+  // The fine pass's evidence at T_map_local, when applied (pose_covariance.h).
+  RegistrationEvidence evidence;
 };
 
 // Refines `match.T_map_local`. `local_points[i]` are the points of query segment i (local map

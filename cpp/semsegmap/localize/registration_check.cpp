@@ -135,6 +135,7 @@ RegistrationCheck checkRegistration(const std::vector<std::vector<Eigen::Vector3
   out.correction_m = translationError(f.T, proposed);
   out.correction_deg = rotationErrorDeg(f.T, proposed);
   out.fitness = overlap(local, fine, f.T, config.near_m);
+  out.evidence = evidenceAt(local, fine, f.T, config.fine_distance_m, config.kernel_scale_m);
   if (out.correction_m > config.max_correction_m || out.correction_deg > config.max_correction_deg)
     out.reason = "registration moved the pose too far";
   else if (out.fitness < config.min_fitness)

@@ -20,6 +20,7 @@
 
 #include "semsegmap/core/pose.h"
 #include "semsegmap/localize/target_map.h"
+#include "semsegmap/odometry/icp.h"
 
 namespace semsegmap {
 
@@ -48,6 +49,8 @@ struct RegistrationCheck {
   size_t points = 0;                    // local points checked
   double correction_m = 0.0, correction_deg = 0.0;
   std::string reason;  // why it was refused ("" when accepted)
+  // The fine registration's evidence at T_map_local (pose_covariance.h), when it ran to the end.
+  RegistrationEvidence evidence;
 };
 
 // `local_points[i]`: the points of local segment i (local map frame; empty ones are skipped);

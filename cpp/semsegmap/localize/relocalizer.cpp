@@ -137,6 +137,7 @@ class Checks {
   // context's starts within one, and the other way round.
   void check(Relocalization r) {
     const Pose& T = r.match.T_map_local;
+    if (!r.by_scan_context) segment_proposals.push_back(T);
     if (!r.by_scan_context) {
       if (std::any_of(checked_.begin(), checked_.end(),
                       [&](const Pose& c) { return samePose(c, T, robot_local_, config_); }))
@@ -144,13 +145,54 @@ class Checks {
       checked_.push_back(T);
     }
     r.check = checkRegistration(points_, robot_local_, map_, T, config_);
-    corroborate(r.check, map_, scan_, relocalization_);
+    // Only the segments' proposals: the scan context cannot corroborate its own.
+    if (!r.by_scan_context) corroborate(r.check, map_, scan_, relocalization_);
+    registered.push_back({r.check.T_map_local, r.check.fitness});
+    if (r.by_scan_context && !r.check.accepted && shortOfFitnessOnly(r.check))
+      short_of_fitness.push_back(r);
     if (!r.check.accepted) return;
     r.match.T_map_local = r.check.T_map_local;
     accepted.push_back(std::move(r));
   }
 
+  // The scan context's proposals that registered short of min_fitness but at least
+  // scan_context_min_fitness, accepted where the segments, the other kind of evidence, proposed
+  // the same pose with a clique of their own (whatever that clique's own check said: its start
+  // may lie metres off, where the check's cheap refusal stops it), or where no other place of
+  // the map looks nearly as alike to the whole scan (scan_context_distinct_ratio): a straight
+  // road or a row of alike houses puts the scan near many mapped scans, and is refused.
+  void acceptWhereTheSegmentsAgree() {
+    for (Relocalization& r : short_of_fitness) {
+      const bool agree = std::any_of(
+          segment_proposals.begin(), segment_proposals.end(),
+          [&](const Pose& T) { return samePose(T, r.check.T_map_local, robot_local_, config_); });
+      // Distances of identical scan contexts come out a rounding error below 0.
+      const bool distinct =
+          std::max(0.0, r.scan_context_distance) <
+          relocalization_.scan_context_distinct_ratio * std::max(0.0, r.scan_context_rival);
+      if (!agree && !distinct) continue;
+      r.check.accepted = true;
+      r.check.reason.clear();
+      r.match.T_map_local = r.check.T_map_local;
+      accepted.push_back(r);
+    }
+  }
+
+  struct Registered {
+    Pose T_map_local;
+    double fitness = 0.0;
+  };
   std::vector<Relocalization> accepted;
+  std::vector<Registered> registered;  // every proposal checked, accepted or not
+
+ private:
+  bool shortOfFitnessOnly(const RegistrationCheck& c) const {
+    return c.points > 0 && c.fitness >= relocalization_.scan_context_min_fitness &&
+           c.correction_m <= config_.max_correction_m &&
+           c.correction_deg <= config_.max_correction_deg;
+  }
+  std::vector<Pose> segment_proposals;  // every clique's pose, checked or not
+  std::vector<Relocalization> short_of_fitness;
 
  private:
   const std::vector<std::vector<Eigen::Vector3f>>& points_;
@@ -196,22 +238,55 @@ size_t checkVotedPlaces(const Localizer& localizer, const std::vector<Eigen::Vec
   return verified;
 }
 
+// The nearest scan context of a mapped scan farther than kRivalM from `best`'s, among the
+// `candidates` of nearest ring keys: how alike another place looks to the scan. 1 (nothing in
+// common) when none is.
+constexpr double kRivalM = 20.0;
+double rivalDistance(const std::vector<ScanContextMatch>& nearest, const ScanContextMatch& best) {
+  for (const ScanContextMatch& m : nearest)
+    if ((m.T_world_candidate.translation() - best.T_world_candidate.translation()).norm() > kRivalM)
+      return m.distance.distance;
+  return 1.0;
+}
+
 // The mapped scan whose scan context is nearest the scan's, turned by their yaw.
 void checkScanContext(const TargetMap& map, const ScanContextQuery& scan,
                       const Eigen::Vector3d& robot_local, const RelocalizationConfig& config,
                       const std::optional<RelocalizationPrior>& prior, Checks& checks) {
-  for (const ScanContextMatch& m :
-       map.scan_contexts.nearest(scan.context, config.scan_context_candidates, 1)) {
+  // Five times the candidates compared in full: enough to find another place that looks alike.
+  const size_t candidates = 5 * config.scan_context_candidates;
+  const std::vector<ScanContextMatch> nearest =
+      map.scan_contexts.nearest(scan.context, candidates, candidates);
+  if (nearest.empty()) return;
+  for (const ScanContextMatch& m : {nearest.front()}) {
     if (m.distance.distance >= config.scan_context_max_distance) continue;
     Relocalization r;
     r.match.T_map_local = m.T_world_query() * scan.T_local_scan.inverse();
     r.by_scan_context = true;
+    r.scan_context_distance = m.distance.distance;
+    r.scan_context_rival = rivalDistance(nearest, m);
     if (prior &&
         ((r.match.T_map_local * robot_local).head<2>() - prior->position.head<2>()).norm() >
             prior->radius_m)
       continue;
     checks.check(std::move(r));
   }
+}
+
+// The best place against the others: another accepted place far from it, or one that
+// registered nearly as well, makes the pose ambiguous.
+void judgeDistinctiveness(Relocalization& best, const Checks& checks,
+                          const Eigen::Vector3d& robot_local, const RelocalizationConfig& config) {
+  const Eigen::Vector3d at = best.match.T_map_local * robot_local;
+  const auto elsewhere = [&](const Pose& T) {
+    return (T * robot_local - at).norm() > config.check.max_correction_m;
+  };
+  for (const Relocalization& r : checks.accepted)
+    if (elsewhere(r.match.T_map_local)) best.ambiguous = true;
+  for (const Checks::Registered& r : checks.registered)
+    if (elsewhere(r.T_map_local))
+      best.runner_up_fitness = std::max(best.runner_up_fitness, r.fitness);
+  if (best.runner_up_fitness >= config.ambiguity_ratio * best.check.fitness) best.ambiguous = true;
 }
 
 }  // namespace
@@ -260,18 +335,15 @@ std::optional<Relocalization> relocalize(
   const size_t verified =
       checkVotedPlaces(localizer, centroids, descriptors, config, prior, checks);
   if (scan && config.scan_context) checkScanContext(map, *scan, robot_local, config, prior, checks);
+  checks.acceptWhereTheSegmentsAgree();
   const std::vector<Relocalization>& accepted = checks.accepted;
   if (accepted.empty()) return std::nullopt;
-  // Two places that both fit, far apart: the scan cannot tell them apart.
-  const Eigen::Vector3d first = accepted[0].match.T_map_local * robot_local;
-  for (const Relocalization& r : accepted)
-    if ((r.match.T_map_local * robot_local - first).norm() > config.check.max_correction_m)
-      return std::nullopt;
   Relocalization best = *std::max_element(accepted.begin(), accepted.end(),
                                           [](const Relocalization& a, const Relocalization& b) {
                                             return a.check.fitness < b.check.fitness;
                                           });
   best.places_verified = verified;
+  judgeDistinctiveness(best, checks, robot_local, config);
   return best;
 }
 

@@ -27,6 +27,8 @@ struct NormalEquations {
   // which would hide that a corridor says nothing along itself.
   Matrix6 H_planes = Matrix6::Zero();
   double plane_weight_sum = 0.0;
+  // For the evidence at the solution: sum of w r^2, and of w per scalar residual.
+  double weighted_squares = 0.0, weighted_residuals = 0.0;
 };
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
@@ -47,6 +49,8 @@ void addCorrespondence(const Eigen::Vector3d& arm, const Eigen::Vector3d& diff,
     eq.b.noalias() += w * r * J;
     eq.weight_sum += w;
     eq.plane_weight_sum += w;
+    eq.weighted_squares += w * r * r;
+    eq.weighted_residuals += w;
   } else {
     const double w = std::pow(k_sq / (k_sq + diff.squaredNorm()), 2);
     Eigen::Matrix<double, 3, 6> J;
@@ -54,6 +58,8 @@ void addCorrespondence(const Eigen::Vector3d& arm, const Eigen::Vector3d& diff,
     eq.H.noalias() += w * J.transpose() * J;
     eq.b.noalias() += w * J.transpose() * diff;
     eq.weight_sum += w;
+    eq.weighted_squares += w * diff.squaredNorm();
+    eq.weighted_residuals += 3.0 * w;
   }
   ++eq.correspondences;
 }
@@ -128,6 +134,28 @@ double rmsNorm(const std::vector<Eigen::Vector3d>& points) {
 }
 
 }  // namespace
+
+void symmetricEigen6(const Matrix6d& A, Eigen::Matrix<double, 6, 1>* values, Matrix6d* vectors) {
+  symmetricEigen(A, values, vectors);
+}
+
+RegistrationEvidence evidenceAt(const std::vector<Eigen::Vector3d>& source, const VoxelMap& map,
+                                const Pose& T, double max_distance_m, double kernel_scale_m,
+                                IcpMetric metric) {
+  const NormalEquations eq =
+      buildSystem(source, map, T, max_distance_m, kernel_scale_m, metric, true);
+  RegistrationEvidence e;
+  // As the update's degeneracy test (solveDamped): where most matches are point-to-plane, the
+  // point-to-point ones (voxels without a plane) would constrain a slide along a wall by the
+  // sampling alone.
+  const bool by_planes = eq.plane_weight_sum > 0.5 * eq.weight_sum;
+  e.information = by_planes ? eq.H_planes : Matrix6(eq.H + eq.H_planes);
+  e.residual_variance =
+      eq.weighted_residuals > 0 ? eq.weighted_squares / eq.weighted_residuals : 0.0;
+  e.centre = T.translation();
+  e.correspondences = eq.correspondences;
+  return e;
+}
 
 IcpResult alignToMap(const std::vector<Eigen::Vector3d>& source, const VoxelMap& map,
                      const Pose& initial, double max_distance_m, double kernel_scale_m,

@@ -42,4 +42,27 @@ IcpResult alignToMap(const std::vector<Eigen::Vector3d>& source, const VoxelMap&
                      const Pose& initial, double max_distance_m, double kernel_scale_m,
                      const IcpConfig& config);
 
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+// What a registration's correspondences say about its pose, at the pose it ended on: the
+// Gauss-Newton information (rotation vector about the source frame's origin carried into the
+// map, then translation, the update's parameters) and the variance of one residual. Their
+// quotient's inverse is the pose's covariance were the residuals independent
+// (localize/pose_covariance.h says why they are not).
+struct RegistrationEvidence {
+  Matrix6d information = Matrix6d::Zero();           // sum of w J J^T over the correspondences
+  double residual_variance = 0.0;                    // sum of w r^2 over sum of w, per residual
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // the rotation's centre, map frame
+  size_t correspondences = 0;
+};
+
+// The evidence of `source` registered at `T` with the same correspondences and kernel as the
+// last iterations of alignToMap.
+RegistrationEvidence evidenceAt(const std::vector<Eigen::Vector3d>& source, const VoxelMap& map,
+                                const Pose& T, double max_distance_m, double kernel_scale_m,
+                                IcpMetric metric = IcpMetric::kPointToPlane);
+
+// Eigenvalues and eigenvectors of a symmetric 6 x 6 matrix (columns of `vectors`).
+void symmetricEigen6(const Matrix6d& A, Eigen::Matrix<double, 6, 1>* values, Matrix6d* vectors);
+
 }  // namespace semsegmap

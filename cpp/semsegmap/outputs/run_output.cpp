@@ -65,18 +65,47 @@ void writeTrajectoryCsv(const std::filesystem::path& path, const SlamRun& run) {
                       {"gt", run.trajectory_gt}});
 }
 
+namespace {
+
+// The localizations and the ambiguous relocalizations, in the order of their frames.
+std::vector<const LocalizationRecord*> rowsOf(const LocalizationRun& run) {
+  std::vector<const LocalizationRecord*> rows;
+  for (const LocalizationRecord& r : run.localizations) rows.push_back(&r);
+  for (const LocalizationRecord& r : run.ambiguous) rows.push_back(&r);
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const LocalizationRecord* a, const LocalizationRecord* b) {
+                     return a->frame_index < b->frame_index;
+                   });
+  return rows;
+}
+
+// ",sigma_x_m,...,sigma_yaw_deg,status" of a row.
+std::string uncertaintyFields(const LocalizationRecord& r) {
+  const Eigen::Matrix<double, 6, 1> s = sigmasOf(r.covariance);
+  char line[256];
+  std::snprintf(line, sizeof(line), ",%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%s", s[0], s[1], s[2], s[3],
+                s[4], s[5], r.ambiguous ? "ambiguous" : "localized");
+  return line;
+}
+
+}  // namespace
+
 void writeLocalizationsCsv(const std::filesystem::path& path, const LocalizationRun& run) {
   writeFileAtomically(path, [&](std::ostream& out) {
-    // The columns of schema semsegmap.localization/3 (summary.json; docs/commands.md), read by
+    // The columns of schema semsegmap.localization/4 (summary.json; docs/commands.md), read by
     // name: dataset_frame and an empty timestamp are what version 1 lacked, path and fitness
-    // what version 2 lacked (its latest_scan column is path = latest-scan).
+    // what version 2 lacked (its latest_scan column is path = latest-scan), the sigmas and
+    // status what version 3 lacked.
     // refinement_m: how far pose refinement moved the pose; empty where it was not applied.
     // path: which segments localized (local-map, latest-scan, relocalization); fitness: a
     // relocalization's registration check, empty for the other paths.
     out << "frame,dataset_frame,timestamp,x,y,z,qx,qy,qz,qw,inliers,translation_error_m,"
-           "rotation_error_deg,refinement_m,path,fitness\n";
+           "rotation_error_deg,refinement_m,path,fitness,runner_up_fitness,sigma_x_m,sigma_y_m,"
+           "sigma_z_m,"
+           "sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,status\n";
     char line[512];
-    for (const LocalizationRecord& r : run.localizations) {
+    for (const LocalizationRecord* row : rowsOf(run)) {
+      const LocalizationRecord& r = *row;
       const auto v = toXyzQuat(r.T_map_base);
       out << r.frame_index << frameStampFields(r.frame_number, r.timestamp_s);
       std::snprintf(line, sizeof(line), ",%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%d", v[0], v[1], v[2],
@@ -100,7 +129,12 @@ void writeLocalizationsCsv(const std::filesystem::path& path, const Localization
         std::snprintf(line, sizeof(line), "%.3f", *r.registration_fitness);
         out << line;
       }
-      out << '\n';
+      out << ',';
+      if (r.runner_up_fitness) {
+        std::snprintf(line, sizeof(line), "%.3f", *r.runner_up_fitness);
+        out << line;
+      }
+      out << uncertaintyFields(r) << '\n';
     }
   });
 }
@@ -152,8 +186,15 @@ std::string localizationSummaryJson(const LocalizationRun& run, const SummaryCon
         std::count_if(run.localizations.begin(), run.localizations.end(),
                       [p](const LocalizationRecord& r) { return r.path == p; });
   j["n_by_path"] = by_path;
+  // Relocalizations that fit another place as well: in localizations.csv, counted nowhere else.
+  j["n_ambiguous"] = run.ambiguous.size();
   j["mean_translation_error_m"] = orNull(s.mean_translation_error_m);
   j["mean_rotation_error_deg"] = orNull(s.mean_rotation_error_deg);
+  // The covariances against the errors (LocalizationSummary): null without ground truth.
+  j["covariance_calibration"] = {
+      {"share_mahalanobis_within_3", orNull(s.share_mahalanobis_within_3)},
+      {"mean_nees", orNull(s.mean_nees)},
+      {"median_sigma_m", orNull(s.median_sigma_m)}};
   j["fps"] = run.stats.fps();
   j["stage_ms"] = stageMsJson(meanStageTimes(run.stats), true);
   j["map_segments"] = c.map_segments;

@@ -22,7 +22,7 @@ namespace semsegmap {
 // dataset's own frame number and left a time the data does not have empty (1 made one up), and
 // writes null for every error or count the run does not know; 3 says which path localized
 // (local-map, latest-scan, relocalization) and a relocalization's fitness, and counts them.
-inline constexpr const char* kLocalizationSchema = "semsegmap.localization/3";
+inline constexpr const char* kLocalizationSchema = "semsegmap.localization/4";
 
 // frame (the run's index), dataset_frame (the dataset's own number, empty when it has none),
 // timestamp (the data's, empty when it has none), T_map_base as x y z qx qy qz qw, inliers, with

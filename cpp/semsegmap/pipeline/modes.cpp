@@ -218,18 +218,39 @@ std::shared_ptr<const TargetMap> checkedMap(std::shared_ptr<const TargetMap> map
     throw std::invalid_argument(
         "the target map stores no segment points, which localization.refinement needs: build "
         "it with target_map.max_points_per_segment (map --points N) or turn refinement off");
-  if (config.localization.relocalization.enabled && !hasSegmentPoints(*map))
-    throw std::invalid_argument(
-        name +
-        ": stores no segment points, which localization.relocalization needs to check a "
-        "pose: build it with target_map.max_points_per_segment (map --points N) or turn "
-        "relocalization off");
-  if (config.localization.relocalization.enabled &&
-      config.localization.relocalization.scan_context && map->scan_contexts.size() == 0)
+  return map;
+}
+
+// Relocalization checks a pose on the map's stored points, about one per 0.5 x 0.5 m of
+// surface (registration_check.h): a map that keeps fewer than this for its largest segments
+// (every map built with the paper's settings, or the 32 points pose refinement needs) cannot
+// tell a right place from a look-alike.
+constexpr size_t kRelocalizationPoints = 256;
+
+// Whether `map` holds what relocalization needs; otherwise relocalization is off for the run,
+// which says so in one line: a robot still localizes on a map built before it, and only loses
+// the wake-up from one scan.
+bool relocalizationPossible(const std::string& name, const TargetMap& map,
+                            const RelocalizationConfig& config) {
+  if (!config.enabled) return false;
+  size_t most = 0;
+  for (const MapSegment& s : map.segments) most = std::max(most, s.points.size());
+  const std::string rebuild =
+      "rebuild the map with target_map.max_points_per_segment: 512 and "
+      "target_map.scan_context_apart_m: 1.0 (as config/lidar-camera.yaml has them)";
+  if (most < kRelocalizationPoints || !hasSegmentPoints(map)) {
+    note(name + ": keeps " + (most == 0 ? std::string("no") : "at most " + std::to_string(most)) +
+         " points a segment, too few to check a relocalization, so relocalization is off for "
+         "this run; " +
+         rebuild);
+    return false;
+  }
+  if (config.scan_context && map.scan_contexts.size() == 0)
     note(name +
          ": holds no scan contexts, so a relocalization checks only the places its segments "
-         "vote for (build the map with target_map.scan_context_apart_m: 1.0 to add them)");
-  return map;
+         "vote for; " +
+         rebuild);
+  return true;
 }
 
 // Each local segment's points, as its latest observation holds them.
@@ -254,6 +275,10 @@ LocalizationSession::LocalizationSession(const PipelineConfig& config, const Dat
                  config.localization.localizer),
       pipeline_(config, info, PoseSource::kOdometry, describer, stages) {
   run_.odometry_is_ground_truth = info_.odometry_is_ground_truth;
+  const TargetMap& target = localizer_.map();
+  config_.localization.relocalization.enabled =
+      relocalizationPossible(target.source.empty() ? "the target map" : target.source, target,
+                             config.localization.relocalization);
 }
 
 // Without history, each list keeps its last entry: the latest frame's poses and stamp (the
@@ -267,6 +292,7 @@ void keepLast(std::vector<T>& v) {
 
 void LocalizationSession::forgetHistory() {
   keepLast(run_.localizations);
+  keepLast(run_.ambiguous);
   keepLast(run_.frames);
   keepLast(run_.trajectory_gt);
   keepLast(run_.trajectory_odom);
@@ -292,7 +318,9 @@ std::optional<LocalizationRecord> LocalizationSession::process(const Frame& fram
         localizeFrame(pipeline_, frame, r.T_local_base, moved, reloc.enabled && lost, prior_);
     r.times.localize_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (o.attempt.found) {
+    if (o.attempt.found && o.attempt.ambiguous) {
+      run_.ambiguous.push_back(recordOf(frame, o));
+    } else if (o.attempt.found) {
       run_.localizations.push_back(recordOf(frame, o));
       found = run_.localizations.back();
       localized_at_m_ = run_.distance_m;
@@ -357,6 +385,7 @@ LocalizationSession::Attempt LocalizationSession::attempt(const Pipeline& pipeli
   if (a.found && config_.localization.refinement.enabled) {
     a.refined = refine(pipeline, *a.found, a.query);
     a.found->T_map_local = a.refined->T_map_local;
+    if (a.refined->applied) a.evidence = a.refined->evidence;
   }
   return a;
 }
@@ -380,6 +409,7 @@ void LocalizationSession::requireRegistration(const Pipeline& pipeline, const Fr
   }
   a.found->T_map_local = c.T_map_local;
   a.fitness = c.fitness;
+  a.evidence = c.evidence;
 }
 
 // The scan's scan context on the map's grid, when the map holds scan contexts and the
@@ -406,6 +436,9 @@ LocalizationSession::Attempt LocalizationSession::attemptRelocalization(
     a.found = r->match;
     a.fitness = r->check.fitness;
     a.by_scan_context = r->by_scan_context;
+    a.ambiguous = r->ambiguous;
+    a.runner_up_fitness = r->runner_up_fitness;
+    a.evidence = r->check.evidence;
   }
   return a;
 }
@@ -437,7 +470,8 @@ std::optional<LocalizationRecord> LocalizationSession::relocalize(
       FrontEndStages{stages_.network, std::nullopt, FrontEndStages::Labelling::kEveryPicture});
   const Pose T_local_base = scan.process(frame).T_local_base;
   const Outcome o = localizeFrame(scan, frame, T_local_base, 0.0, true, prior);
-  if (!o.attempt.found) return std::nullopt;
+  // An ambiguous pose is no answer: the scan fits another place as well.
+  if (!o.attempt.found || o.attempt.ambiguous) return std::nullopt;
   return recordOf(frame, o);
 }
 
@@ -467,6 +501,15 @@ LocalizationRecord LocalizationSession::recordOf(const Frame& frame, const Outco
     rec.matches.emplace_back(
         (l.T_map_local * a.query.centroids.at(query).cast<double>()).cast<float>(),
         localizer_.map().segments.at(target).centroid);
+  rec.ambiguous = a.ambiguous;
+  if (a.ambiguous || a.by_scan_context || o.path == LocalizationPath::kRelocalization)
+    rec.runner_up_fitness = a.runner_up_fitness;
+  const PoseCovarianceConfig& cc = config_.localization.covariance;
+  rec.covariance =
+      a.evidence ? covarianceFromEvidence(*a.evidence, rec.T_map_base.translation(),
+                                          cc.registration_inflation, cc)
+                 : covarianceFromEvidence(centroidEvidence(rec.matches),
+                                          rec.T_map_base.translation(), cc.centroid_inflation, cc);
   return rec;
 }
 
@@ -499,6 +542,31 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
   return run;
 }
 
+namespace {
+
+void summarizeCovariances(const std::vector<LocalizationRecord>& records, LocalizationSummary& s) {
+  std::vector<double> sigmas;
+  double nees_sum = 0.0;
+  size_t within = 0;
+  for (const LocalizationRecord& r : records) {
+    if (!r.T_world_base) continue;
+    const double nees =
+        positionNees(r.covariance, r.T_map_base.translation() - r.T_world_base->translation());
+    nees_sum += nees;
+    within += nees <= 9.0;
+    sigmas.push_back(std::sqrt(r.covariance.topLeftCorner<3, 3>().trace() / 3.0));
+  }
+  if (sigmas.empty()) return;
+  const double n = static_cast<double>(sigmas.size());
+  s.share_mahalanobis_within_3 = static_cast<double>(within) / n;
+  s.mean_nees = nees_sum / n;
+  std::nth_element(sigmas.begin(), sigmas.begin() + static_cast<long>(sigmas.size() / 2),
+                   sigmas.end());
+  s.median_sigma_m = sigmas[sigmas.size() / 2];
+}
+
+}  // namespace
+
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {
   LocalizationSummary s;
   s.localizations = records.size();
@@ -520,6 +588,7 @@ LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {
     s.mean_translation_error_m = translation / static_cast<double>(s.with_ground_truth);
     s.mean_rotation_error_deg = rotation / static_cast<double>(s.with_ground_truth);
   }
+  summarizeCovariances(records, s);
   return s;
 }
 

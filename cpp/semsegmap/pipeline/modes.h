@@ -133,10 +133,21 @@ struct LocalizationRecord {
   LocalizationPath path = LocalizationPath::kLocalMap;
   // Relocalization: the share of the local points that lie on the map's after registration.
   std::optional<double> registration_fitness;
+  // The pose's uncertainty from its own evidence: 6 x 6 in the map frame, ROS order (x, y, z,
+  // roll, pitch, yaw; localize/pose_covariance.h).
+  Covariance6 covariance = Covariance6::Identity();
+  // A relocalization whose scan registers nearly as well at another place
+  // (relocalization.ambiguity_ratio): recorded with its status, never used as a pose, never
+  // counted as a localization (LocalizationRun::ambiguous).
+  bool ambiguous = false;
+  std::optional<double> runner_up_fitness;  // of a relocalization: the best place elsewhere
 };
 
 struct LocalizationRun {
   std::vector<LocalizationRecord> localizations;
+  // Relocalizations that fit two places (LocalizationRecord::ambiguous): kept apart, so that
+  // every count of localizations stays one of poses a robot may act on.
+  std::vector<LocalizationRecord> ambiguous;
   std::vector<Pose> trajectory_gt;    // empty without ground truth
   std::vector<Pose> trajectory_odom;  // the robot's own estimate, in its odometry frame
   std::vector<FrameStamp> frames;     // per frame run (as trajectory_odom): the data's names
@@ -191,6 +202,11 @@ class LocalizationSession {
     std::optional<Refinement> refined;
     std::optional<double> fitness;  // of a relocalization's registration check
     bool by_scan_context = false;   // the relocalization's pose was the scan context's
+    bool ambiguous = false;         // the relocalization's scan fits another place too
+    std::optional<double> runner_up_fitness;
+    // What the pose's covariance comes from: the last registration that moved or checked it
+    // (with its inflation), or nothing: the matched centroids.
+    std::optional<RegistrationEvidence> evidence;
     LocalSegmentQuery query;
   };
   Attempt attempt(const Pipeline& pipeline) const;
@@ -245,6 +261,11 @@ struct LocalizationSummary {
   // counts when a localization had no ground truth, the means when none had.
   std::optional<size_t> below_1m, below_5m;
   std::optional<double> mean_translation_error_m, mean_rotation_error_deg;
+  // How honest the covariances are, over the localizations with ground truth (position, 3
+  // degrees of freedom): the share whose Mahalanobis distance is at most 3 (ideal 0.97), the
+  // mean NEES (ideal 3), and the median position sigma (the root of the mean of the three
+  // variances), so that a huge covariance cannot pass for an honest one.
+  std::optional<double> share_mahalanobis_within_3, mean_nees, median_sigma_m;
 };
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records);
 // The same, and the counts unknown too when the run had no ground truth at all (no

@@ -8,6 +8,7 @@
 #include "semsegmap/graph/pose_graph.h"
 #include "semsegmap/local_map/local_map.h"
 #include "semsegmap/localize/localizer.h"
+#include "semsegmap/localize/pose_covariance.h"
 #include "semsegmap/localize/pose_refinement.h"
 #include "semsegmap/localize/relocalizer.h"
 #include "semsegmap/localize/target_map.h"
@@ -42,6 +43,8 @@ struct LocalizationConfig {
   RefinementConfig refinement;
   // When neither localizes: one scan against the whole map (localize/relocalizer.h).
   RelocalizationConfig relocalization;
+  // The covariance every localization carries (localize/pose_covariance.h).
+  PoseCovarianceConfig covariance;
 };
 
 struct LoopClosureConfig {

@@ -257,6 +257,22 @@ void checkRelocalizationSettings(const std::filesystem::path& path, const Reloca
         "scan_context_max_distance: must be in [0, 1]");
   check(c.scan_context_min_fitness >= 0 && c.scan_context_min_fitness <= 1,
         "scan_context_min_fitness: must be in [0, 1]");
+  check(c.ambiguity_ratio > 0 && c.ambiguity_ratio <= 1, "ambiguity_ratio: must be in (0, 1]");
+  check(c.scan_context_distinct_ratio >= 0 && c.scan_context_distinct_ratio <= 1,
+        "scan_context_distinct_ratio: must be in [0, 1]");
+}
+
+void checkCovarianceSettings(const std::filesystem::path& path, const PoseCovarianceConfig& c) {
+  auto check = [&](bool ok, const std::string& what) {
+    if (!ok) throw std::runtime_error(path.string() + ": localization.covariance." + what);
+  };
+  check(c.registration_inflation > 0 && c.centroid_inflation > 0,
+        "registration_inflation, centroid_inflation: must be positive");
+  check(c.min_sigma_m >= 0 && c.min_sigma_deg >= 0,
+        "min_sigma_m, min_sigma_deg: must not be negative");
+  check(c.max_sigma_m > c.min_sigma_m && c.max_sigma_deg > c.min_sigma_deg,
+        "max_sigma_m, max_sigma_deg: must exceed the floors");
+  check(c.degeneracy_ratio >= 0 && c.degeneracy_ratio < 1, "degeneracy_ratio: must be in [0, 1)");
 }
 
 // The cross-field checks and the limits a number has beyond being finite, of the sections read.
@@ -306,6 +322,7 @@ void checkPipelineSettings(const std::filesystem::path& path, const Settings& c)
   check(c.loop_closure.exclude_recent_m >= 0,
         "loop_closure.exclude_recent_m: must not be negative");
   checkRelocalizationSettings(path, loc.relocalization);
+  checkCovarianceSettings(path, loc.covariance);
 }
 
 void checkOdometrySettings(const std::filesystem::path& path, const OdometryConfig& c) {
