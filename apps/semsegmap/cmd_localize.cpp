@@ -207,8 +207,8 @@ const CommandSpec& localizeCommand() {
               {"allow-config-mismatch", Value::kFlag, "", "",
                "localize even when the map was built with other settings (listed on stderr)"},
               {"relocalize", Value::kFlag, "", "",
-               "search the whole map when not localized for a while "
-               "(localization.relocalization; the map needs segment points)"},
+               "search the whole map when not localized for a while (localization.relocalization, "
+               "on in config/lidar-camera.yaml; a map without its points localizes without it)"},
               {"prior", Value::kText, "X,Y[,RADIUS]", "",
                "relocalize only within RADIUS m (default 50) of X,Y in the map frame"},
               {"follow", Value::kFlag, "", "",

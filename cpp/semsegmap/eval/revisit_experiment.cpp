@@ -174,7 +174,21 @@ RevisitResult resultOf(const RevisitExperiment& e, const std::string& name,
     r.mean_registered_rotation_error_deg /= static_cast<double>(r.registered_compared);
   }
   r.wake_ups = wakeUpsOf(e, r.localizations);
-  const LocalizationSummary s = summarize(run.localizations);
+  LocalizationSummary s = summarize(run.localizations);
+  // The covariances against the registered ground truth where the scan registered, as the
+  // wake-ups are judged (a recorded ground truth can be off by most of a metre at a revisit).
+  std::vector<std::pair<const Covariance6*, Eigen::Vector3d>> errors;
+  for (const LocalizationRecord& l : run.localizations) {
+    const auto q = std::find_if(e.queries.begin(), e.queries.end(),
+                                [&](const RevisitFrame& f) { return f.frame == l.frame_index; });
+    const std::optional<Pose> reference = q != e.queries.end() && q->T_world_base_registered
+                                              ? q->T_world_base_registered
+                                              : l.T_world_base;
+    if (reference)
+      errors.emplace_back(&l.covariance, l.T_map_base.translation() - reference->translation());
+  }
+  s.share_mahalanobis_within_3 = s.mean_nees = s.median_sigma_m = std::nullopt;
+  summarizeCovariances(errors, s);
   r.mean_translation_error_m = s.mean_translation_error_m;
   r.mean_rotation_error_deg = s.mean_rotation_error_deg;
   r.ambiguous = run.ambiguous.size();

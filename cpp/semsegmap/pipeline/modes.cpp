@@ -542,19 +542,17 @@ LocalizationRun runLocalization(FrameSource& source, const PipelineConfig& confi
   return run;
 }
 
-namespace {
-
-void summarizeCovariances(const std::vector<LocalizationRecord>& records, LocalizationSummary& s) {
+void summarizeCovariances(
+    const std::vector<std::pair<const Covariance6*, Eigen::Vector3d>>& covariance_and_error,
+    LocalizationSummary& s) {
   std::vector<double> sigmas;
   double nees_sum = 0.0;
   size_t within = 0;
-  for (const LocalizationRecord& r : records) {
-    if (!r.T_world_base) continue;
-    const double nees =
-        positionNees(r.covariance, r.T_map_base.translation() - r.T_world_base->translation());
+  for (const auto& [covariance, error] : covariance_and_error) {
+    const double nees = positionNees(*covariance, error);
     nees_sum += nees;
     within += nees <= 9.0;
-    sigmas.push_back(std::sqrt(r.covariance.topLeftCorner<3, 3>().trace() / 3.0));
+    sigmas.push_back(std::sqrt(covariance->topLeftCorner<3, 3>().trace() / 3.0));
   }
   if (sigmas.empty()) return;
   const double n = static_cast<double>(sigmas.size());
@@ -564,8 +562,6 @@ void summarizeCovariances(const std::vector<LocalizationRecord>& records, Locali
                    sigmas.end());
   s.median_sigma_m = sigmas[sigmas.size() / 2];
 }
-
-}  // namespace
 
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {
   LocalizationSummary s;
@@ -588,7 +584,12 @@ LocalizationSummary summarize(const std::vector<LocalizationRecord>& records) {
     s.mean_translation_error_m = translation / static_cast<double>(s.with_ground_truth);
     s.mean_rotation_error_deg = rotation / static_cast<double>(s.with_ground_truth);
   }
-  summarizeCovariances(records, s);
+  std::vector<std::pair<const Covariance6*, Eigen::Vector3d>> errors;
+  for (const LocalizationRecord& r : records)
+    if (r.T_world_base)
+      errors.emplace_back(&r.covariance,
+                          r.T_map_base.translation() - r.T_world_base->translation());
+  summarizeCovariances(errors, s);
   return s;
 }
 

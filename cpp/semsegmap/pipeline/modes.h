@@ -268,6 +268,11 @@ struct LocalizationSummary {
   std::optional<double> share_mahalanobis_within_3, mean_nees, median_sigma_m;
 };
 LocalizationSummary summarize(const std::vector<LocalizationRecord>& records);
+// The covariance fields of a summary from each pose's covariance and position error (the
+// reference may be other than the record's ground truth: eval revisits' registered one).
+void summarizeCovariances(
+    const std::vector<std::pair<const Covariance6*, Eigen::Vector3d>>& covariance_and_error,
+    LocalizationSummary& s);
 // The same, and the counts unknown too when the run had no ground truth at all (no
 // localization then does not mean none was wrong).
 LocalizationSummary summarize(const LocalizationRun& run);
