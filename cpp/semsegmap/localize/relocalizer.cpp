@@ -137,8 +137,8 @@ class Checks {
   // context's starts within one, and the other way round.
   void check(Relocalization r) {
     const Pose& T = r.match.T_map_local;
-    if (!r.by_scan_context) segment_proposals.push_back(T);
     if (!r.by_scan_context) {
+      segment_proposals.push_back(T);
       if (std::any_of(checked_.begin(), checked_.end(),
                       [&](const Pose& c) { return samePose(c, T, robot_local_, config_); }))
         return;
@@ -193,8 +193,6 @@ class Checks {
   }
   std::vector<Pose> segment_proposals;  // every clique's pose, checked or not
   std::vector<Relocalization> short_of_fitness;
-
- private:
   const std::vector<std::vector<Eigen::Vector3f>>& points_;
   Eigen::Vector3d robot_local_;
   const TargetMap& map_;
@@ -257,20 +255,18 @@ void checkScanContext(const TargetMap& map, const ScanContextQuery& scan,
   const size_t candidates = 5 * config.scan_context_candidates;
   const std::vector<ScanContextMatch> nearest =
       map.scan_contexts.nearest(scan.context, candidates, candidates);
-  if (nearest.empty()) return;
-  for (const ScanContextMatch& m : {nearest.front()}) {
-    if (m.distance.distance >= config.scan_context_max_distance) continue;
-    Relocalization r;
-    r.match.T_map_local = m.T_world_query() * scan.T_local_scan.inverse();
-    r.by_scan_context = true;
-    r.scan_context_distance = m.distance.distance;
-    r.scan_context_rival = rivalDistance(nearest, m);
-    if (prior &&
-        ((r.match.T_map_local * robot_local).head<2>() - prior->position.head<2>()).norm() >
-            prior->radius_m)
-      continue;
-    checks.check(std::move(r));
-  }
+  if (nearest.empty() || nearest.front().distance.distance >= config.scan_context_max_distance)
+    return;
+  const ScanContextMatch& m = nearest.front();
+  Relocalization r;
+  r.match.T_map_local = m.T_world_query() * scan.T_local_scan.inverse();
+  r.by_scan_context = true;
+  r.scan_context_distance = m.distance.distance;
+  r.scan_context_rival = rivalDistance(nearest, m);
+  if (prior && ((r.match.T_map_local * robot_local).head<2>() - prior->position.head<2>()).norm() >
+                   prior->radius_m)
+    return;
+  checks.check(std::move(r));
 }
 
 // The best place against the others: another accepted place far from it, or one that

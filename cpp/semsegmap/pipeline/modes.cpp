@@ -502,8 +502,7 @@ LocalizationRecord LocalizationSession::recordOf(const Frame& frame, const Outco
         (l.T_map_local * a.query.centroids.at(query).cast<double>()).cast<float>(),
         localizer_.map().segments.at(target).centroid);
   rec.ambiguous = a.ambiguous;
-  if (a.ambiguous || a.by_scan_context || o.path == LocalizationPath::kRelocalization)
-    rec.runner_up_fitness = a.runner_up_fitness;
+  rec.runner_up_fitness = a.runner_up_fitness;  // a relocalization's alone
   const PoseCovarianceConfig& cc = config_.localization.covariance;
   rec.covariance =
       a.evidence ? covarianceFromEvidence(*a.evidence, rec.T_map_base.translation(),
