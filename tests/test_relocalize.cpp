@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "error_text.h"
 #include "semsegmap/core/pose.h"
 #include "semsegmap/core/random.h"
 #include "semsegmap/localize/pose_covariance.h"
@@ -49,6 +50,26 @@ TEST(RegistrationCheck, AcceptsThePosePointsLieOnAndRefusesAnother) {
       checkRegistration(q.points, q.robot_local, town.map, elsewhere, config);
   EXPECT_FALSE(wrong.accepted);
   EXPECT_FALSE(wrong.reason.empty());
+}
+
+// A pose that tilts the local map against the map (both are level on a ground robot) is a
+// symmetry's fit, however well the points lie: refused beyond check.max_tilt_deg.
+TEST(RegistrationCheck, RefusesAPoseThatTiltsTheLocalMap) {
+  const Town town = makeTown(300, 300, 1);
+  const Eigen::Vector3d robot(150, 150, 0);
+  const Pose tilted =
+      someLocalFrame() * Eigen::AngleAxisd(20.0 * M_PI / 180, Eigen::Vector3d::UnitX());
+  const Query q = queryAt(town, robot, tilted, 50, 0.0, 2);
+  RegistrationCheckConfig config;
+  const RegistrationCheck refused =
+      checkRegistration(q.points, q.robot_local, town.map, tilted, config);
+  EXPECT_FALSE(refused.accepted);
+  EXPECT_GT(refused.fitness, 0.9) << "the points lie on the map's";
+  EXPECT_EQ(refused.reason, "the pose tilts the local map against the map");
+  config.max_tilt_deg = 25.0;
+  const RegistrationCheck allowed =
+      checkRegistration(q.points, q.robot_local, town.map, tilted, config);
+  EXPECT_TRUE(allowed.accepted) << allowed.reason;
 }
 
 TEST(RegistrationCheck, RefusesTooFewPointsWithAReason) {
@@ -273,6 +294,21 @@ TEST(Relocalizer, TheMapsScanContextsCorroborateOnlyAPoseThatAgreesWithThem) {
   EXPECT_TRUE(scanContextAgrees(t.map, t.scan, poseOf(66, 2), config)) << "a sector off";
   EXPECT_FALSE(scanContextAgrees(t.map, t.scan, poseOf(90, 2), config));
   EXPECT_FALSE(scanContextAgrees(t.map, t.scan, poseOf(60, 20), config));
+  // The same mapped scan contradicts a pose turned a quarter from the heading its context gives,
+  // and says nothing of a pose where no mapped scan lies near.
+  EXPECT_FALSE(headingContradicted(t.map, t.scan, poseOf(60, 2)));
+  EXPECT_FALSE(headingContradicted(t.map, t.scan, poseOf(66, 2)));
+  EXPECT_TRUE(headingContradicted(t.map, t.scan, poseOf(150, 2)));
+  EXPECT_TRUE(headingContradicted(t.map, t.scan, poseOf(240, 2)));
+  EXPECT_FALSE(headingContradicted(t.map, t.scan, poseOf(150, 20)));
+  RegistrationCheck turned;
+  turned.accepted = true;
+  turned.T_map_local = poseOf(150, 2);
+  refuseAContradictedHeading(turned, t.map, std::nullopt, config);
+  EXPECT_TRUE(turned.accepted) << "without the scan's scan context nothing is refused";
+  refuseAContradictedHeading(turned, t.map, t.scan, config);
+  EXPECT_FALSE(turned.accepted);
+  EXPECT_MENTIONS(turned.reason, "contradict its heading");
 
   // corroborate() lets such a pose pass with scan_context_min_fitness, not less, and only with the
   // scan's scan context.
@@ -364,6 +400,24 @@ TEST(Relocalizer, AScanContextsOwnWrongProposalBelowTheFitnessIsRefused) {
                   << " m from the robot, fitness " << r->check.fitness << " sc "
                   << r->by_scan_context << " d " << r->scan_context_distance << " rival "
                   << r->scan_context_rival;
+}
+
+// A localization farther from the held pose than jump_m, or turned more than jump_deg, is a jump
+// (modes.cpp then asks the registration check for it): the world-5 VLP-32's local-map pose two
+// scans after a right relocalization, 5.3 m and 15 degrees off, is one.
+TEST(Relocalizer, APoseFarFromTheHeldOneIsAJump) {
+  const RelocalizationConfig config;
+  const Pose held =
+      Eigen::Translation3d(10, 20, 0) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
+  const auto moved = [&](double x, double yaw_deg) {
+    return held * Eigen::Translation3d(x, 0, 0) *
+           Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ());
+  };
+  EXPECT_FALSE(jumpsFrom(held, held, config));
+  EXPECT_FALSE(jumpsFrom(held, moved(0.5 * config.jump_m, 0.5 * config.jump_deg), config));
+  EXPECT_TRUE(jumpsFrom(held, moved(1.1 * config.jump_m, 0), config));
+  EXPECT_TRUE(jumpsFrom(held, moved(0, 1.1 * config.jump_deg), config));
+  EXPECT_TRUE(jumpsFrom(held, moved(5.3, 15.0), config));
 }
 
 TEST(Relocalizer, RefusesMismatchedInput) {

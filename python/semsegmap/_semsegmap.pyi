@@ -242,6 +242,7 @@ class RegistrationCheckConfig:
     min_points: int
     max_correction_m: float
     max_correction_deg: float
+    max_tilt_deg: float
     place_radius_m: float
     def __init__(self, **fields: object) -> None: ...
 
@@ -249,6 +250,8 @@ class RelocalizationConfig:
     _fields: tuple[str, ...]
     enabled: bool
     after_m: float
+    jump_m: float
+    jump_deg: float
     k: int
     k_in_place: int
     place_radius_m: float

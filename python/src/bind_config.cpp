@@ -98,11 +98,14 @@ void bindLocalizationConfigs(py::module_& m) {
       .field("min_points", &RC::min_points)
       .field("max_correction_m", &RC::max_correction_m)
       .field("max_correction_deg", &RC::max_correction_deg)
+      .field("max_tilt_deg", &RC::max_tilt_deg)
       .field("place_radius_m", &RC::place_radius_m);
   using RL = RelocalizationConfig;
   StructBinding<RL>(m, "RelocalizationConfig", "localize/relocalizer.h")
       .field("enabled", &RL::enabled)
       .field("after_m", &RL::after_m)
+      .field("jump_m", &RL::jump_m)
+      .field("jump_deg", &RL::jump_deg)
       .field("k", &RL::k)
       .field("k_in_place", &RL::k_in_place)
       .field("place_radius_m", &RL::place_radius_m)

@@ -49,9 +49,8 @@ Covariance6 covarianceFromEvidence(const RegistrationEvidence& evidence,
   const Eigen::Vector3d arm = robot_map - evidence.centre;
   // No residual spread (a perfect synthetic fit) still leaves the floors.
   const double variance = std::max(evidence.residual_variance * inflation, 1e-12);
-  const Covariance6 params =
-      cappedInverse(evidence.information, evidence.correspondences, variance,
-                    std::max(1.0, arm.norm()), config);
+  const Covariance6 params = cappedInverse(evidence.information, evidence.correspondences, variance,
+                                           std::max(1.0, arm.norm()), config);
   // The robot moves with the rotation about the centre: dr = -[arm]x omega + dt; the
   // orientation turns by omega.
   Covariance6 G = Covariance6::Zero();
@@ -64,8 +63,8 @@ Covariance6 covarianceFromEvidence(const RegistrationEvidence& evidence,
   const double cap_rad2 = std::pow(config.max_sigma_deg * kDegree, 2);
   for (int i = 0; i < 6; ++i) {
     const bool position = i < 3;
-    const double floor =
-        position ? config.min_sigma_m * config.min_sigma_m : std::pow(config.min_sigma_deg * kDegree, 2);
+    const double floor = position ? config.min_sigma_m * config.min_sigma_m
+                                  : std::pow(config.min_sigma_deg * kDegree, 2);
     c(i, i) = std::clamp(c(i, i) + floor, floor, position ? cap_m2 : cap_rad2);
   }
   return c;

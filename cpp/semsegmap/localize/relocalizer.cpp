@@ -117,9 +117,11 @@ bool samePose(const Pose& a, const Pose& b, const Eigen::Vector3d& robot_local,
          rotationErrorDeg(a, b) <= check.max_correction_deg;
 }
 
-// The proposals' registration checks: a proposal that puts the robot where an earlier one did is
-// not checked again (neighbouring places share segments, and a weaker one often verifies to the
-// same pose).
+// The proposals' registration checks. Proposals are queued in the order they were made, the
+// scan context's last; a proposal that puts the robot where an earlier one did is not checked
+// again (neighbouring places share segments, and a weaker one often verifies to the same pose).
+// The checks then run side by side: each registers the scan on its own place's points, tens of
+// milliseconds for a wrong place, and a lost frame checks ten or twenty.
 class Checks {
  public:
   Checks(const std::vector<std::vector<Eigen::Vector3f>>& points,
@@ -132,24 +134,52 @@ class Checks {
         config_(relocalization.check),
         scan_(scan) {}
 
-  // The scan context's pose is checked whatever was checked before, and is no reason to skip a
+  // The scan context's pose is checked whatever was proposed before, and is no reason to skip a
   // place after it: a voted place's clique can start the registration metres off where the scan
   // context's starts within one, and the other way round.
-  void check(Relocalization r) {
+  void propose(Relocalization r) {
     const Pose& T = r.match.T_map_local;
     if (!r.by_scan_context) {
-      segment_proposals.push_back(T);
-      if (std::any_of(checked_.begin(), checked_.end(),
-                      [&](const Pose& c) { return samePose(c, T, robot_local_, config_); }))
+      segment_proposals_.push_back(T);
+      if (std::any_of(queued_.begin(), queued_.end(), [&](const Relocalization& q) {
+            return !q.by_scan_context && samePose(q.match.T_map_local, T, robot_local_, config_);
+          }))
         return;
-      checked_.push_back(T);
     }
-    r.check = checkRegistration(points_, robot_local_, map_, T, config_);
+    queued_.push_back(std::move(r));
+  }
+
+  // Every queued proposal's check, then the verdicts in the order they were proposed, so that the
+  // result does not depend on which thread finished first.
+  void run() {
+    const int n = static_cast<int>(queued_.size());
+    std::vector<RegistrationCheck> checked(queued_.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int i = 0; i < n; ++i)
+      checked[static_cast<size_t>(i)] = checkRegistration(
+          points_, robot_local_, map_, queued_[static_cast<size_t>(i)].match.T_map_local, config_);
+    for (size_t i = 0; i < queued_.size(); ++i) judge(std::move(queued_[i]), std::move(checked[i]));
+    queued_.clear();
+    acceptWhereTheSegmentsAgree();
+  }
+
+  struct Registered {
+    Pose T_map_local;
+    double fitness = 0.0;
+  };
+  std::vector<Relocalization> accepted;
+  std::vector<Registered> registered;  // every proposal checked, accepted or not
+
+ private:
+  void judge(Relocalization r, RegistrationCheck check) {
+    r.check = std::move(check);
     // Only the segments' proposals: the scan context cannot corroborate its own.
     if (!r.by_scan_context) corroborate(r.check, map_, scan_, relocalization_);
+    // The scan context's own proposal has the heading of its mapped scan.
+    if (!r.by_scan_context) refuseAContradictedHeading(r.check, map_, scan_, relocalization_);
     registered.push_back({r.check.T_map_local, r.check.fitness});
     if (r.by_scan_context && !r.check.accepted && shortOfFitnessOnly(r.check))
-      short_of_fitness.push_back(r);
+      short_of_fitness_.push_back(r);
     if (!r.check.accepted) return;
     r.match.T_map_local = r.check.T_map_local;
     accepted.push_back(std::move(r));
@@ -162,9 +192,9 @@ class Checks {
   // the map looks nearly as alike to the whole scan (scan_context_distinct_ratio): a straight
   // road or a row of alike houses puts the scan near many mapped scans, and is refused.
   void acceptWhereTheSegmentsAgree() {
-    for (Relocalization& r : short_of_fitness) {
+    for (Relocalization& r : short_of_fitness_) {
       const bool agree = std::any_of(
-          segment_proposals.begin(), segment_proposals.end(),
+          segment_proposals_.begin(), segment_proposals_.end(),
           [&](const Pose& T) { return samePose(T, r.check.T_map_local, robot_local_, config_); });
       // Distances of identical scan contexts come out a rounding error below 0.
       const bool distinct =
@@ -178,28 +208,20 @@ class Checks {
     }
   }
 
-  struct Registered {
-    Pose T_map_local;
-    double fitness = 0.0;
-  };
-  std::vector<Relocalization> accepted;
-  std::vector<Registered> registered;  // every proposal checked, accepted or not
-
- private:
   bool shortOfFitnessOnly(const RegistrationCheck& c) const {
     return c.points > 0 && c.fitness >= relocalization_.scan_context_min_fitness &&
            c.correction_m <= config_.max_correction_m &&
            c.correction_deg <= config_.max_correction_deg;
   }
-  std::vector<Pose> segment_proposals;  // every clique's pose, checked or not
-  std::vector<Relocalization> short_of_fitness;
+  std::vector<Relocalization> queued_;
+  std::vector<Pose> segment_proposals_;  // every clique's pose, checked or not
+  std::vector<Relocalization> short_of_fitness_;
   const std::vector<std::vector<Eigen::Vector3f>>& points_;
   Eigen::Vector3d robot_local_;
   const TargetMap& map_;
   const RelocalizationConfig& relocalization_;
   const RegistrationCheckConfig& config_;
   const std::optional<ScanContextQuery>& scan_;
-  std::vector<Pose> checked_;
 };
 
 // Steps 1 and 2 (relocalizer.h): the places the local segments vote for, each verified with the
@@ -231,7 +253,7 @@ size_t checkVotedPlaces(const Localizer& localizer, const std::vector<Eigen::Vec
     Relocalization r;
     r.match = localizationOf(v, candidates);
     r.votes = place.votes;
-    checks.check(std::move(r));
+    checks.propose(std::move(r));
   }
   return verified;
 }
@@ -266,7 +288,7 @@ void checkScanContext(const TargetMap& map, const ScanContextQuery& scan,
   if (prior && ((r.match.T_map_local * robot_local).head<2>() - prior->position.head<2>()).norm() >
                    prior->radius_m)
     return;
-  checks.check(std::move(r));
+  checks.propose(std::move(r));
 }
 
 // The best place against the others: another accepted place far from it, or one that
@@ -287,20 +309,60 @@ void judgeDistinctiveness(Relocalization& best, const Checks& checks,
 
 }  // namespace
 
-bool scanContextAgrees(const TargetMap& map, const ScanContextQuery& scan, const Pose& T_map_local,
-                       const RelocalizationConfig& config) {
+bool jumpsFrom(const Pose& held, const Pose& given, const RelocalizationConfig& config) {
+  return (held.translation() - given.translation()).norm() > config.jump_m ||
+         rotationErrorDeg(held, given) > config.jump_deg;
+}
+
+namespace {
+
+struct NearbyScan {
+  double distance = 1.0;    // of its scan context to the scan's
+  bool yaw_agrees = false;  // the pose's yaw within two sectors of the one their contexts give
+};
+
+// The mapped scans within 10 m of where T_map_local puts the scan.
+std::vector<NearbyScan> mappedScansNear(const TargetMap& map, const ScanContextQuery& scan,
+                                        const Pose& T_map_local) {
   constexpr double kNearM = 10.0;
   const Pose T_map_scan = T_map_local * scan.T_local_scan;
   const double sector = 2.0 * M_PI / static_cast<double>(map.scan_contexts.config().sectors);
+  std::vector<NearbyScan> out;
   for (const ScanContextDatabase::MappedScan& m : map.scan_contexts.scans()) {
     if ((m.T_world_scan.translation() - T_map_scan.translation()).norm() > kNearM) continue;
     const ScanContextDistance d = scanContextDistance(scan.context, m.context);
-    if (d.distance >= config.scan_context_max_distance) continue;
     // The yaw the pose gives between the mapped scan's frame and the scan's, against theirs.
     const double yaw = yawOf(m.T_world_scan.inverse() * T_map_scan);
-    if (std::abs(std::remainder(yaw - d.yaw_rad, 2.0 * M_PI)) <= 2.0 * sector) return true;
+    out.push_back(
+        {d.distance, std::abs(std::remainder(yaw - d.yaw_rad, 2.0 * M_PI)) <= 2.0 * sector});
   }
-  return false;
+  return out;
+}
+
+}  // namespace
+
+bool scanContextAgrees(const TargetMap& map, const ScanContextQuery& scan, const Pose& T_map_local,
+                       const RelocalizationConfig& config) {
+  const std::vector<NearbyScan> near = mappedScansNear(map, scan, T_map_local);
+  return std::any_of(near.begin(), near.end(), [&](const NearbyScan& s) {
+    return s.yaw_agrees && s.distance < config.scan_context_max_distance;
+  });
+}
+
+bool headingContradicted(const TargetMap& map, const ScanContextQuery& scan,
+                         const Pose& T_map_local) {
+  const std::vector<NearbyScan> near = mappedScansNear(map, scan, T_map_local);
+  return !near.empty() &&
+         std::none_of(near.begin(), near.end(), [](const NearbyScan& s) { return s.yaw_agrees; });
+}
+
+void refuseAContradictedHeading(RegistrationCheck& check, const TargetMap& map,
+                                const std::optional<ScanContextQuery>& scan,
+                                const RelocalizationConfig& config) {
+  if (!check.accepted || !scan || !config.scan_context) return;
+  if (!headingContradicted(map, *scan, check.T_map_local)) return;
+  check.accepted = false;
+  check.reason = "the map's scans nearby contradict its heading";
 }
 
 void corroborate(RegistrationCheck& check, const TargetMap& map,
@@ -331,7 +393,7 @@ std::optional<Relocalization> relocalize(
   const size_t verified =
       checkVotedPlaces(localizer, centroids, descriptors, config, prior, checks);
   if (scan && config.scan_context) checkScanContext(map, *scan, robot_local, config, prior, checks);
-  checks.acceptWhereTheSegmentsAgree();
+  checks.run();
   const std::vector<Relocalization>& accepted = checks.accepted;
   if (accepted.empty()) return std::nullopt;
   Relocalization best = *std::max_element(accepted.begin(), accepted.end(),

@@ -355,7 +355,8 @@ LocalizationSession::Outcome LocalizationSession::localizeFrame(
     bool relocalize, const std::optional<RelocalizationPrior>& prior) const {
   Outcome o;
   o.attempt = attempt(pipeline);
-  if (relocalize) requireRegistration(pipeline, frame, T_local_base, o.attempt);
+  if (relocalize || jumps(o.attempt, T_local_base))
+    requireRegistration(pipeline, frame, T_local_base, o.attempt);
   const Pipeline* tried = &pipeline;
   Pose base = T_local_base;
   std::optional<Pipeline> scan;
@@ -365,7 +366,7 @@ LocalizationSession::Outcome LocalizationSession::localizeFrame(
     // The scan as the front-end stages left it: labelled and posed.
     base = scan->process(pipeline.processedFrame(frame)).T_local_base;
     o.attempt = attempt(*scan);
-    if (relocalize) requireRegistration(*scan, frame, base, o.attempt);
+    if (relocalize || jumps(o.attempt, base)) requireRegistration(*scan, frame, base, o.attempt);
     o.path = LocalizationPath::kLatestScan;
     tried = &*scan;
   }
@@ -400,8 +401,11 @@ void LocalizationSession::requireRegistration(const Pipeline& pipeline, const Fr
   RegistrationCheck c =
       checkRegistration(segmentPoints(pipeline, a.query), T_local_base.translation(),
                         localizer_.map(), a.found->T_map_local, config.check);
-  // The scan context only matters to a pose the points alone did not accept.
-  if (!c.accepted) corroborate(c, localizer_.map(), scanContextQuery(frame, T_local_base), config);
+  // The scan context only matters to a pose the points alone did not accept, and to one whose
+  // heading the map's scans nearby contradict.
+  const std::optional<ScanContextQuery> scan = scanContextQuery(frame, T_local_base);
+  if (!c.accepted) corroborate(c, localizer_.map(), scan, config);
+  refuseAContradictedHeading(c, localizer_.map(), scan, config);
   if (!c.accepted) {
     a.found.reset();
     a.refined.reset();
@@ -410,6 +414,15 @@ void LocalizationSession::requireRegistration(const Pipeline& pipeline, const Fr
   a.found->T_map_local = c.T_map_local;
   a.fitness = c.fitness;
   a.evidence = c.evidence;
+}
+
+// Whether a pose found while the robot holds one (not lost) lies farther from it than
+// relocalization.jump_m or jump_deg: then it must pass the registration check too. Only with the
+// map's points at hand (relocalization on); the simulator's configurations keep the paper's path.
+bool LocalizationSession::jumps(const Attempt& a, const Pose& T_local_base) const {
+  const RelocalizationConfig& config = config_.localization.relocalization;
+  if (!a.found || !T_map_local_ || !config.enabled) return false;
+  return jumpsFrom(*T_map_local_ * T_local_base, a.found->T_map_local * T_local_base, config);
 }
 
 // The scan's scan context on the map's grid, when the map holds scan contexts and the

@@ -215,6 +215,7 @@ class LocalizationSession {
                                 const std::optional<RelocalizationPrior>& prior) const;
   void requireRegistration(const Pipeline& pipeline, const Frame& frame, const Pose& T_local_base,
                            Attempt& a) const;
+  bool jumps(const Attempt& a, const Pose& T_local_base) const;
   std::optional<ScanContextQuery> scanContextQuery(const Frame& frame,
                                                    const Pose& T_local_base) const;
   struct Outcome {

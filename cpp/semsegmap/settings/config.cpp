@@ -237,6 +237,7 @@ void checkRelocalizationSettings(const std::filesystem::path& path, const Reloca
     if (!ok) throw std::runtime_error(path.string() + ": localization.relocalization." + what);
   };
   check(c.after_m >= 0, "after_m: must not be negative");
+  check(c.jump_m > 0 && c.jump_deg > 0, "jump_m, jump_deg: must be positive");
   check(c.place_radius_m > 0 && c.cell_m > 0, "place_radius_m, cell_m: must be positive");
   check(c.cell_m <= c.place_radius_m, "cell_m: must not exceed place_radius_m");
   check(c.verification.resolution_m > 0 && c.verification.inlier_tolerance_m > 0,
@@ -253,6 +254,7 @@ void checkRelocalizationSettings(const std::filesystem::path& path, const Reloca
   check(r.min_fitness >= 0 && r.min_fitness <= 1, "check.min_fitness: must be in [0, 1]");
   check(r.max_correction_m > 0 && r.max_correction_deg > 0,
         "check: max_correction_m and max_correction_deg must be positive");
+  check(r.max_tilt_deg > 0 && r.max_tilt_deg <= 180, "check.max_tilt_deg: must be in (0, 180]");
   check(c.scan_context_max_distance >= 0 && c.scan_context_max_distance <= 1,
         "scan_context_max_distance: must be in [0, 1]");
   check(c.scan_context_min_fitness >= 0 && c.scan_context_min_fitness <= 1,
