@@ -110,11 +110,15 @@ std::vector<Correspondence> candidatesIn(const Neighbours& nn, const TargetMap& 
   return out;
 }
 
+// The robot at `robot` under both poses within m metres, and the poses within deg degrees.
+bool within(const Pose& a, const Pose& b, const Eigen::Vector3d& robot, double m, double deg) {
+  return (a * robot - b * robot).norm() <= m && rotationErrorDeg(a, b) <= deg;
+}
+
 // The robot within the check's own tolerance in both: registration would take one to the other.
 bool samePose(const Pose& a, const Pose& b, const Eigen::Vector3d& robot_local,
               const RegistrationCheckConfig& check) {
-  return (a * robot_local - b * robot_local).norm() <= check.max_correction_m &&
-         rotationErrorDeg(a, b) <= check.max_correction_deg;
+  return within(a, b, robot_local, check.max_correction_m, check.max_correction_deg);
 }
 
 // The proposals' registration checks. Proposals are queued in the order they were made, the
@@ -173,10 +177,12 @@ class Checks {
  private:
   void judge(Relocalization r, RegistrationCheck check) {
     r.check = std::move(check);
-    // Only the segments' proposals: the scan context cannot corroborate its own.
-    if (!r.by_scan_context) corroborate(r.check, map_, scan_, relocalization_);
-    // The scan context's own proposal has the heading of its mapped scan.
-    if (!r.by_scan_context) refuseAContradictedHeading(r.check, map_, scan_, relocalization_);
+    // Only the segments' proposals: the scan context cannot corroborate its own, and its own has
+    // the heading of its mapped scan.
+    if (!r.by_scan_context) {
+      corroborate(r.check, map_, scan_, relocalization_);
+      refuseAContradictedHeading(r.check, map_, scan_, relocalization_);
+    }
     registered.push_back({r.check.T_map_local, r.check.fitness});
     if (r.by_scan_context && !r.check.accepted && shortOfFitnessOnly(r.check))
       short_of_fitness_.push_back(r);
@@ -310,8 +316,7 @@ void judgeDistinctiveness(Relocalization& best, const Checks& checks,
 }  // namespace
 
 bool jumpsFrom(const Pose& held, const Pose& given, const RelocalizationConfig& config) {
-  return (held.translation() - given.translation()).norm() > config.jump_m ||
-         rotationErrorDeg(held, given) > config.jump_deg;
+  return !within(held, given, Eigen::Vector3d::Zero(), config.jump_m, config.jump_deg);
 }
 
 namespace {
